@@ -1,0 +1,191 @@
+"""Turn a :class:`~derivations.mechanism.SymbolicMechanism` into Python source
+that builds CasADi ``Function`` objects.
+
+The generated module is readable (common subexpressions as named locals), has
+no sympy dependency, and starts with a header naming its source, the sympy
+version and a hash of its inputs (the derivation sources).  ``zerocal regen``
+rewrites it; ``zerocal regen --check`` compares a fresh derivation with the
+committed file.
+"""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import sympy as sp
+from sympy.printing.pycode import PythonCodePrinter
+
+_CA_FUNCS = ["sin", "cos", "tan", "asin", "acos", "atan", "atan2", "exp", "log", "sign", "fabs"]
+
+
+class CasadiPrinter(PythonCodePrinter):
+    """Print sympy expressions as CasADi-compatible Python (``ca.<fn>``)."""
+
+    _kf = {**{k: "ca." + k for k in _CA_FUNCS}, "Abs": "ca.fabs"}
+
+    def _print_Pow(self, expr, rational=False):
+        return self._hprint_Pow(expr, rational=rational, sqrt="ca.sqrt")
+
+    def _print_known_func(self, expr):
+        known = self.known_functions[expr.__class__.__name__]
+        return "{}({})".format(known, ", ".join(self._print(a) for a in expr.args))
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+
+for _k in CasadiPrinter._kf:
+    setattr(CasadiPrinter, "_print_" + _k, CasadiPrinter._print_known_func)
+
+
+HERE = Path(__file__).resolve().parent
+GENERATED_DIR = HERE.parent / "zerocal_sym" / "generated"
+
+
+def input_hash(sources) -> str:
+    """SHA-256 (first 16 hex digits) over the derivation sources."""
+    h = hashlib.sha256()
+    for path in sorted(sources):
+        h.update(Path(path).name.encode())
+        h.update(Path(path).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _matrix_code(name: str, mat: sp.Matrix, printer) -> str:
+    rows = []
+    for i in range(mat.rows):
+        rows.append("ca.horzcat(" + ", ".join(printer.doprint(mat[i, j]) for j in range(mat.cols)) + ")")
+    if mat.cols == 1:
+        body = "ca.vertcat(" + ", ".join(printer.doprint(mat[i, 0]) for i in range(mat.rows)) + ")"
+    else:
+        body = "ca.vertcat(\n        " + ",\n        ".join(rows) + ",\n    )"
+    return f"    {name} = {body}"
+
+
+def emit_function(fname: str, spec: dict, printer) -> str:
+    """Python source of ``_<fname>(inputs...)`` returning CasADi expressions."""
+    args = [n for n, _ in spec["inputs"]]
+    lines = [f"def _{fname}({', '.join(args)}):", f'    """{spec["doc"]}"""']
+    names = [n for n, _ in spec["outputs"]]
+    mats = [m for _, m in spec["outputs"]]
+    flat = [e for m in mats for e in m]
+    used = set().union(*(e.free_symbols for e in flat))
+    for argname, syms in spec["inputs"]:
+        for k, s in enumerate(syms):
+            if s in used:
+                lines.append(f"    {printer.doprint(s)} = {argname}[{k}]")
+    repl, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"), optimizations="basic")
+    for sym, expr in repl:
+        lines.append(f"    {printer.doprint(sym)} = {printer.doprint(expr)}")
+    pos = 0
+    for name, m in zip(names, mats):
+        n = m.rows * m.cols
+        lines.append(_matrix_code(name, sp.Matrix(m.rows, m.cols, reduced[pos:pos + n]), printer))
+        pos += n
+    lines.append(f"    return ({', '.join(names)},)")
+    return "\n".join(lines)
+
+
+def render(mech, sources) -> str:
+    """The full generated module for ``mech`` as a string."""
+    printer = CasadiPrinter({"fully_qualified_modules": True, "inline": True})
+    src_names = ", ".join(f"derivations/{Path(p).name}" for p in sorted(sources))
+    out = [
+        f'"""Generated CasADi builders for the mechanism ``{mech.name}``.',
+        "",
+        "GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.",
+        f"source: {src_names}",
+        f"inputs hash: {input_hash(sources)}",
+        f"sympy: {sp.__version__}",
+        '"""',
+        "import casadi as ca",
+        "",
+        f"NAME = {mech.name!r}",
+        f"POSE_NAMES = {[str(s) for s in mech.pose]!r}",
+        f"JOINT_NAMES = {[str(s) for s in mech.joints]!r}",
+        f"GEOMETRY_NAMES = {[str(s) for s in mech.geometry]!r}",
+        f"SOURCE_ERROR_NAMES = {[n for n, _ in mech.source_errors]!r}",
+        "FUNCTION_SIGNATURES = {",
+    ]
+    for fname, spec in mech.outputs.items():
+        ins = [(n, len(s)) for n, s in spec["inputs"]]
+        outs = [(n, tuple(m.shape)) for n, m in spec["outputs"]]
+        out.append(f"    {fname!r}: ({ins!r}, {outs!r}),")
+    out.append("}")
+    for fname, spec in mech.outputs.items():
+        out += ["", "", emit_function(fname, spec, printer)]
+    out += [
+        "",
+        "",
+        "def build_functions():",
+        '    """Build every CasADi ``Function`` of this mechanism (SX graphs).',
+        "",
+        "    Returns",
+        "    -------",
+        "    dict of str -> casadi.Function",
+        '    """',
+        "    funcs = {}",
+        "    for fname, (ins, outs) in FUNCTION_SIGNATURES.items():",
+        "        syms = [ca.SX.sym(n, k) for n, k in ins]",
+        "        res = globals()['_' + fname](*syms)",
+        "        funcs[fname] = ca.Function(fname, syms, list(res), [n for n, _ in ins], [n for n, _ in outs])",
+        "    return funcs",
+        "",
+    ]
+    return "\n".join(out)
+
+
+MECHANISMS = {"planar_2dof": "derivations.planar_2dof"}
+
+
+def generate(out_dir: Path | None = None, check_forms: bool = True) -> dict:
+    """Derive every mechanism and return ``{path: source}`` (nothing written).
+
+    Parameters
+    ----------
+    out_dir : Path, optional
+        Directory the files are meant for (default ``zerocal_sym/generated``).
+    check_forms : bool
+        Also assert the symbolic reduction to the paper's forms.
+    """
+    import importlib
+
+    out_dir = Path(out_dir) if out_dir else GENERATED_DIR
+    files = {}
+    for name, modname in MECHANISMS.items():
+        mod = importlib.import_module(modname)
+        mech = mod.build()
+        if check_forms and hasattr(mod, "check_paper_forms"):
+            mod.check_paper_forms(mech)
+        sources = [HERE / "mechanism.py", HERE / "codegen.py", Path(mod.__file__)]
+        files[out_dir / f"{name}.py"] = render(mech, sources)
+    return files
+
+
+def regen(out_dir: Path | None = None, check: bool = False) -> list:
+    """Write (or with ``check`` compare) the generated modules.
+
+    Returns
+    -------
+    list of Path
+        The files that differ from a fresh derivation (``check``) or that
+        were written.
+    """
+    files = generate(out_dir)
+    changed = []
+    for path, text in files.items():
+        old = path.read_text() if path.exists() else None
+        if old != text:
+            changed.append(path)
+            if not check:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text(text)
+    return changed
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    changed = regen(check="--check" in sys.argv)
+    for p in changed:
+        print(p)

@@ -1,0 +1,24 @@
+"""The runtime never imports sympy; the CLI answers --help."""
+import subprocess
+import sys
+
+
+def test_import_does_not_pull_sympy():
+    code = ("import sys, zerocal_sym, zerocal_sym.kinematics, zerocal_sym.fisher, zerocal_sym.data; "
+            "from zerocal_sym.robot import paper_robot; paper_robot().home_pose(); "
+            "assert 'sympy' not in sys.modules, 'sympy imported'")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_cli_commands_do_not_pull_sympy():
+    code = ("import sys; from zerocal_sym.cli import main; rc = main(['robot', '--json']); "
+            "assert rc == 0; assert 'sympy' not in sys.modules, 'sympy imported'")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_help():
+    r = subprocess.run([sys.executable, "-m", "zerocal_sym", "--help"], capture_output=True, text=True)
+    assert r.returncode == 0
+    assert "robot" in r.stdout and "regen" in r.stdout

@@ -1,0 +1,12 @@
+"""zerocal_sym: zero-offset calibration of parallel robots.
+
+Layers (imports go one way): ``derivations/`` (sympy, not imported at run
+time) -> :mod:`zerocal_sym.generated` (committed CasADi builders) ->
+:mod:`~zerocal_sym.mechanisms`, :mod:`~zerocal_sym.robot`,
+:mod:`~zerocal_sym.kinematics`, :mod:`~zerocal_sym.measurement`,
+:mod:`~zerocal_sym.fisher` (models) -> identification and design -> CLI and
+notebooks.
+
+Units: mm and radians inside; degrees at the user-facing edges.
+"""
+__version__ = "0.1.0"

@@ -1,0 +1,3 @@
+from zerocal_sym.cli import entry
+
+entry()

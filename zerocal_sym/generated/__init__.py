@@ -1,0 +1,1 @@
+"""Generated CasADi builders, one module per mechanism (``zerocal regen``)."""

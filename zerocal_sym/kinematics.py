@@ -1,0 +1,233 @@
+"""Numeric kinematics on top of the generated CasADi functions.
+
+Everything here is batched over K poses: poses are ``ndarray, shape (K, 2)``
+in mm, joint angles ``ndarray, shape (K, 2)`` in radians.  Degrees appear only
+at the user-facing edges (CLI, data files, reports).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from zerocal_sym.errors import PoseError
+
+
+def _cols(a, n):
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 1:
+        a = a.reshape(1, -1)
+    if a.shape[-1] != n:
+        raise ValueError(f"expected shape (K, {n}), got {a.shape}")
+    return a
+
+
+def _call(robot, fname, *args):
+    """Evaluate a generated function column-wise over K poses.
+
+    Array arguments of shape (K, n) are passed as (n, K): CasADi maps the
+    function over the columns.  Returns the outputs as numpy arrays with
+    shape (K, rows, cols).
+    """
+    K = max(np.asarray(a).shape[0] for a in args if np.asarray(a).ndim == 2)
+    f = robot.mechanism[fname]
+    ins = [np.asarray(a, float).T if np.asarray(a).ndim == 2 else np.asarray(a, float) for a in args]
+    outs = f(*ins)
+    if not isinstance(outs, tuple):
+        outs = (outs,)
+    res = []
+    for k, o in enumerate(outs):
+        r, c = f.size_out(k)
+        res.append(o.full().reshape(r, K, c).transpose(1, 0, 2))
+    return res
+
+
+def ik(robot, P, check: bool = True):
+    """Inverse kinematics on the branch continuous with home.
+
+    Parameters
+    ----------
+    robot : Robot
+    P : ndarray, shape (K, 2)
+        Platform positions, mm.
+    check : bool
+        Raise :class:`PoseError` naming the first unreachable pose.
+
+    Returns
+    -------
+    ndarray, shape (K, 2)
+        Joint angles, rad.
+    """
+    P = _cols(P, 2)
+    theta, ratio = _call(robot, "ik", P, robot.geometry)
+    theta = theta[:, :, 0]
+    if check:
+        bad = np.flatnonzero(~np.all(np.abs(ratio[:, :, 0]) <= 1.0, axis=1) | ~np.all(np.isfinite(theta), axis=1))
+        if bad.size:
+            k = int(bad[0])
+            raise PoseError(f"pose ({P[k, 0]:g}, {P[k, 1]:g}) mm is unreachable (a limb cannot close)",
+                            where=f"pose {k}")
+    return theta
+
+
+def fk(robot, theta):
+    """Forward kinematics (the assembly mode farther from the base).
+
+    Parameters
+    ----------
+    theta : ndarray, shape (K, 2)
+        Joint angles, rad.
+
+    Returns
+    -------
+    ndarray, shape (K, 2)
+        Positions, mm; NaN where the distal circles do not meet.
+    """
+    return _call(robot, "fk", _cols(theta, 2), robot.geometry)[0][:, :, 0]
+
+
+def _at_pose(robot, fname, P, theta=None):
+    P = _cols(P, 2)
+    theta = ik(robot, P) if theta is None else _cols(theta, 2)
+    return _call(robot, fname, P, theta, robot.geometry)[0]
+
+
+def error_jacobian(robot, P, theta=None):
+    """Paper Eq. (13): ``dP = J dq`` with ``dq = (L1 dth1, L2 dth2)``.
+
+    Returns
+    -------
+    ndarray, shape (K, 2, 2)
+    """
+    return _at_pose(robot, "error_jacobian", P, theta)
+
+
+def error_jacobian_full(robot, P, theta=None):
+    """Paper Eq. (12): ``dP = J' dq'``, ``dq' = (L1 dth1, de1x, de1y, dL1, dl1, L2 dth2, ...)``.
+
+    Returns
+    -------
+    ndarray, shape (K, 2, 10)
+    """
+    return _at_pose(robot, "error_jacobian_full", P, theta)
+
+
+def pose_error_jacobian(robot, P, theta=None):
+    """dP / d(source errors), in the mechanism's source-error order without rM.
+
+    Returns
+    -------
+    ndarray, shape (K, 2, 10)
+        Columns: theta1 theta2 (per rad), e1x e1y e2x e2y L1 L2 l1 l2 (per mm).
+    """
+    return _at_pose(robot, "pose_error_jacobian", P, theta)
+
+
+def transmission(robot, P, theta=None):
+    """Sines of the transmission angles ``(u_1, w_1)``, ``(u_2, w_2)`` and of ``(w_1, w_2)``.
+
+    A zero is a singular configuration (serial for the first two, parallel for
+    the third).
+
+    Returns
+    -------
+    ndarray, shape (K, 3)
+    """
+    return _at_pose(robot, "transmission", P, theta)[:, :, 0]
+
+
+def measuring_vector(robot, P):
+    """Nominal measuring-mechanism length and unit vector.
+
+    Returns
+    -------
+    lam : ndarray, shape (K,)
+    lam_hat : ndarray, shape (K, 2)
+    """
+    lam, lam_hat = _call(robot, "measuring", _cols(P, 2), robot.geometry)
+    return lam[:, 0, 0], lam_hat[:, :, 0]
+
+
+def g_rows(robot, P, theta=None):
+    """Rows ``g_k = lam_hat_k^T [J_k, -I]`` of paper Eq. (28).
+
+    Returns
+    -------
+    ndarray, shape (K, 4)
+    """
+    return _at_pose(robot, "g_row", P, theta)[:, 0, :]
+
+
+def distance(robot, theta_cmd, err=None):
+    """Exact measuring-mechanism length for commanded joints and source errors.
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, 2)
+        Commanded joint angles, rad.
+    err : ndarray, shape (12,) or (K, 12), optional
+        Source errors (rad, mm) in ``robot.mechanism.source_error_names`` order.
+
+    Returns
+    -------
+    ndarray, shape (K,)
+    """
+    theta_cmd = _cols(theta_cmd, 2)
+    err = np.zeros(len(robot.mechanism.source_error_names)) if err is None else np.asarray(err, float)
+    return _call(robot, "distance", theta_cmd, robot.geometry, err)[0][:, 0, 0]
+
+
+def check_poses(robot, P, margin=None, in_workspace=False, tol=1e-6):
+    """Raise :class:`PoseError` for the first unusable pose.
+
+    Checks reachability, the singularity margin (every ``|sin|`` of
+    :func:`transmission` at least ``margin``) and, if asked, the workspace.
+
+    Returns
+    -------
+    theta : ndarray, shape (K, 2)
+    """
+    P = _cols(P, 2)
+    if not np.all(np.isfinite(P)):
+        k = int(np.flatnonzero(~np.all(np.isfinite(P), axis=1))[0])
+        raise PoseError("pose is not finite", where=f"pose {k}")
+    if in_workspace:
+        lo, hi = robot.workspace_bounds()
+        out = np.flatnonzero(np.any((P < lo - tol) | (P > hi + tol), axis=1))
+        if out.size:
+            k = int(out[0])
+            raise PoseError(
+                f"pose ({P[k, 0]:g}, {P[k, 1]:g}) mm is outside the workspace "
+                f"x in [{lo[0]:g}, {hi[0]:g}], y in [{lo[1]:g}, {hi[1]:g}]", where=f"pose {k}")
+    theta = ik(robot, P)
+    margin = robot.singularity_margin if margin is None else margin
+    s = np.abs(transmission(robot, P, theta))
+    bad = np.flatnonzero(np.min(s, axis=1) < margin)
+    if bad.size:
+        k = int(bad[0])
+        raise PoseError(
+            f"pose ({P[k, 0]:g}, {P[k, 1]:g}) mm is too close to a singular configuration "
+            f"(min |sin transmission angle| = {np.min(s[k]):.3g} < margin {margin:g})", where=f"pose {k}")
+    return theta
+
+
+def distance_jacobians(robot, theta_cmd, err=None):
+    """Exact distance and its derivatives (CasADi AD of the exact model).
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, 2)
+        Commanded joint angles, rad.
+    err : ndarray, shape (12,) or (K, 12), optional
+        Source errors at which to linearise (default zero).
+
+    Returns
+    -------
+    rho : ndarray, shape (K,)
+    drho_derr : ndarray, shape (K, 12)
+        Per rad for the joint offsets, per mm for the rest.
+    drho_dtheta : ndarray, shape (K, 2)
+        Per rad.
+    """
+    theta_cmd = _cols(theta_cmd, 2)
+    err = np.zeros(len(robot.mechanism.source_error_names)) if err is None else np.asarray(err, float)
+    rho, de, dt = _call(robot, "distance_jacobians", theta_cmd, robot.geometry, err)
+    return rho[:, 0, 0], de[:, 0, :], dt[:, 0, :]

@@ -1,0 +1,195 @@
+"""The measuring process: source errors, noise model and a virtual plant.
+
+The scale's reading head is reset after each measurement, so what is measured
+at pose k (k >= 1) is the change ``s_k = rho_k - rho_{k-1} + m_k`` of the
+measuring-mechanism length; the reading at the first pose is 0 by definition.
+(The paper indexes the same changes as ``s_k = rho_{k+1} - rho_k``, k = 1..K-1.)
+
+Noise (paper Section 6.1, each switchable and scalable):
+
+* scale error per measured change ``m_k ~ N(0, sigma_m^2)``,
+  ``sigma_m = (3 + l0/1000)/3 um`` with ``l0 = 350 mm`` (Eq. 34);
+* servo motion error per joint per pose ``xi ~ N(0, sigma_xi^2)``,
+  ``sigma_xi = (1/3)(4/10^4)(1/eta) 360 deg`` with ``eta = 20`` (Eq. 35).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from zerocal_sym import kinematics as kin
+
+SOURCE_ERROR_NAMES = ("theta1", "theta2", "e1x", "e1y", "e2x", "e2y",
+                      "L1", "L2", "l1", "l2", "rMx", "rMy")
+#: indices of the zero offsets and of the MAEMM in the source-error vector
+ZERO_OFFSETS = (0, 1)
+MAEMM = (10, 11)
+GEOMETRIC = tuple(range(2, 10))
+
+
+def paper_sigma_scale_mm(l0_mm: float = 350.0) -> float:
+    """Eq. (34): std of the scale error per measured change, mm."""
+    return (3.0 + l0_mm / 1000.0) / 3.0 * 1e-3
+
+
+def paper_sigma_servo_rad(eta: float = 20.0, pulses: float = 1e4, pulse_err: float = 4.0) -> float:
+    """Eq. (35): std of the servo motion error per joint per pose, rad."""
+    return np.radians((1.0 / 3.0) * (pulse_err / pulses) * (1.0 / eta) * 360.0)
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """Gaussian measurement noise.
+
+    Attributes
+    ----------
+    sigma_scale_mm : float
+        Std of each measured change of the scale, mm.
+    sigma_servo_rad : float
+        Std of each joint's motion error at each pose, rad.
+    """
+
+    sigma_scale_mm: float = 0.0
+    sigma_servo_rad: float = 0.0
+
+    @classmethod
+    def paper(cls, scale: float = 1.0, servo: float = 1.0) -> "NoiseModel":
+        """The paper's noise, each term multiplied by a factor."""
+        return cls(scale * paper_sigma_scale_mm(), servo * paper_sigma_servo_rad())
+
+    @classmethod
+    def named(cls, name: str) -> "NoiseModel":
+        """``paper`` | ``scale-only`` | ``servo-only`` | ``none``."""
+        table = {"paper": cls.paper(), "scale-only": cls.paper(servo=0.0),
+                 "servo-only": cls.paper(scale=0.0), "none": cls()}
+        if name not in table:
+            raise ValueError(f"unknown noise model {name!r} (known: {', '.join(table)})")
+        return table[name]
+
+    @property
+    def is_zero(self) -> bool:
+        return self.sigma_scale_mm == 0 and self.sigma_servo_rad == 0
+
+
+def source_errors(zero_offsets_deg=(0.0, 0.0), geometric_mm=None, maemm_mm=(0.0, 0.0)):
+    """Assemble a source-error vector.
+
+    Parameters
+    ----------
+    zero_offsets_deg : (2,)
+    geometric_mm : dict or sequence of 8, optional
+        ``e1x e1y e2x e2y L1 L2 l1 l2``.
+    maemm_mm : (2,)
+
+    Returns
+    -------
+    ndarray, shape (12,)
+        rad for the offsets, mm otherwise, in :data:`SOURCE_ERROR_NAMES` order.
+    """
+    err = np.zeros(12)
+    err[list(ZERO_OFFSETS)] = np.radians(np.asarray(zero_offsets_deg, float))
+    if geometric_mm is not None:
+        if isinstance(geometric_mm, dict):
+            for k, v in geometric_mm.items():
+                err[SOURCE_ERROR_NAMES.index(k)] = v
+        else:
+            err[list(GEOMETRIC)] = np.asarray(geometric_mm, float)
+    err[list(MAEMM)] = np.asarray(maemm_mm, float)
+    return err
+
+
+#: Geometric error "set A" of the paper's Table 2, mm.
+SET_A = {"e1x": 0.03, "e1y": -0.02, "e2x": -0.02, "e2y": 0.01,
+         "L1": 0.01, "L2": 0.02, "l1": -0.03, "l2": -0.02}
+#: Table 2: group -> (dtheta1 deg, dtheta2 deg, geometric scale of set A, MAEMM mm)
+TABLE2 = {
+    1: (2.0, -1.0, 1.0, (1.0, 0.5)),
+    2: (-1.0, 0.5, 1.0, (1.0, 0.5)),
+    3: (0.5, 0.25, 1.0, (1.0, 0.5)),
+    4: (2.0, -1.0, 0.1, (1.0, 0.5)),
+    5: (-1.0, 0.5, 0.1, (1.0, 0.5)),
+    6: (0.5, 0.25, 0.1, (1.0, 0.5)),
+}
+
+
+def table2_errors(group: int, geometric: bool = True) -> np.ndarray:
+    """Source errors of the paper's Table 2 group (1..6), ndarray shape (12,)."""
+    if group not in TABLE2:
+        raise ValueError(f"group must be 1..6, got {group}")
+    t1, t2, s, maemm = TABLE2[group]
+    geo = {k: s * v for k, v in SET_A.items()} if geometric else None
+    return source_errors((t1, t2), geo, maemm)
+
+
+class VirtualPlant:
+    """A simulated robot with source errors and the measuring mechanism.
+
+    Parameters
+    ----------
+    robot : Robot
+        Nominal robot (what the controller believes).
+    err : ndarray, shape (12,)
+        True source errors (rad, mm).
+    """
+
+    def __init__(self, robot, err):
+        self.robot = robot
+        self.err = np.asarray(err, float)
+
+    def actual_pose(self, theta_cmd):
+        """Where the platform actually is for commanded joints (no noise).
+
+        Returns
+        -------
+        ndarray, shape (K, 2)
+        """
+        actual = replace(self.robot, geometry=self.robot.geometry + _geometry_error(self.robot, self.err))
+        return kin.fk(actual, np.asarray(theta_cmd) + self.err[list(ZERO_OFFSETS)])
+
+    def lengths(self, theta_cmd, noise: NoiseModel | None = None, rng=None):
+        """Actual measuring-mechanism lengths, servo error included.
+
+        Returns
+        -------
+        ndarray, shape (K,)
+        """
+        theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
+        if noise is not None and noise.sigma_servo_rad > 0:
+            rng = np.random.default_rng(rng)
+            theta_cmd = theta_cmd + rng.normal(0.0, noise.sigma_servo_rad, theta_cmd.shape)
+        return kin.distance(self.robot, theta_cmd, self.err)
+
+    def measure(self, theta_cmd, noise: NoiseModel | None = None, rng=None):
+        """Scale readings at K commanded poses (head reset after each reading).
+
+        Parameters
+        ----------
+        theta_cmd : ndarray, shape (K, 2)
+            Commanded joint angles, rad.
+        noise : NoiseModel, optional
+        rng : numpy Generator or seed, optional
+
+        Returns
+        -------
+        ndarray, shape (K,)
+            ``readings[0] = 0``; ``readings[k] = rho_k - rho_{k-1} + m_k``, mm.
+        """
+        rng = np.random.default_rng(rng)
+        rho = self.lengths(theta_cmd, noise, rng)
+        s = np.diff(rho)
+        if noise is not None and noise.sigma_scale_mm > 0:
+            s = s + rng.normal(0.0, noise.sigma_scale_mm, s.shape)
+        return np.concatenate([[0.0], s])
+
+
+def _geometry_error(robot, err):
+    """Map the robot part of the source errors onto the geometry vector."""
+    names = robot.mechanism.geometry_names
+    dg = np.zeros(len(names))
+    for k, n in enumerate(SOURCE_ERROR_NAMES):
+        if n in names:
+            dg[names.index(n)] += err[k]
+    dg[names.index("cx")] += err[MAEMM[0]]
+    dg[names.index("cy")] += err[MAEMM[1]]
+    return dg
