@@ -22,3 +22,12 @@ def test_help():
     r = subprocess.run([sys.executable, "-m", "zerocal_sym", "--help"], capture_output=True, text=True)
     assert r.returncode == 0
     assert "robot" in r.stdout and "regen" in r.stdout
+
+
+def test_help_path_does_not_import_casadi():
+    """Command modules import heavy packages inside run(): --help stays fast."""
+    code = ("import sys; from zerocal_sym.cli import build_parser; build_parser(); "
+            "heavy = [m for m in ('casadi', 'sympy', 'matplotlib', 'scipy') if m in sys.modules]; "
+            "assert not heavy, heavy")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
