@@ -1,0 +1,102 @@
+"""Turn an identification result into what a controller takes.
+
+Sign convention: the actual joint angle is the commanded one plus the zero
+offset, so the controller subtracts the identified offset:
+
+    theta_cmd = IK(P) - offset
+
+Outputs (CSV, written atomically to --out, or printed):
+
+* no pose list: the compensation table ``joint,offset_deg,std_deg``;
+* with ``--poses FILE.csv`` (``[pose,]x_mm,y_mm``) or ``--scheme paper --n N``:
+  the compensated joint commands per pose
+  (``pose,x_mm,y_mm,theta1_nominal_deg,theta2_nominal_deg,theta1_cmd_deg,theta2_cmd_deg``);
+* with ``--template`` as well: a measurement file to fill in (the format of
+  ``zerocal identify``, ``reading_mm`` blank) with the compensated commands --
+  the next measurement round, or without RESULT the first one.
+
+Examples:
+
+    zerocal compensate result.json --out compensation.csv
+    zerocal compensate result.json --scheme paper --n 3 --out commands.csv
+    zerocal compensate --scheme paper --n 3 --template --out round1.csv
+"""
+NAME = "compensate"
+HELP = "write the compensation table / compensated joint commands from a result"
+
+
+def add_arguments(p):
+    p.add_argument("result", metavar="RESULT.json", nargs="?", default=None,
+                   help="results file of 'zerocal identify --json' (omit for no compensation, with --template)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--poses", metavar="FILE.csv", default=None, help="target positions: CSV [pose,]x_mm,y_mm")
+    g.add_argument("--scheme", choices=["paper"], default=None, help="the paper's 2n boundary poses")
+    p.add_argument("--n", type=int, default=3, help="poses per boundary for --scheme paper (default 3)")
+    p.add_argument("--template", action="store_true",
+                   help="write a measurement file to fill in (reading_mm blank) instead of a command table")
+    p.add_argument("--max-offset-deg", type=float, default=10.0,
+                   help="refuse offsets larger than this (default 10 deg: not a zero offset)")
+    p.add_argument("--out", metavar="FILE.csv", default=None, help="output file (default: print)")
+    p.add_argument("--json", action="store_true", help="print a JSON summary")
+
+
+def run(args):
+    import numpy as np
+
+    from zerocal_sym import data
+    from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.errors import DataFileError, ZerocalError
+    from zerocal_sym.io import atomic_write_text, to_json
+
+    robot = load_robot_arg(args)
+    has_poses = args.poses is not None or args.scheme is not None
+    if args.result is None and not (args.template and has_poses):
+        raise ZerocalError("give RESULT.json (or, for a first measurement round without compensation, "
+                           "--template with --poses or --scheme)")
+    if args.template and not has_poses:
+        raise ZerocalError("--template needs the poses: --poses FILE.csv or --scheme paper --n N")
+    if args.result is not None:
+        res = data.load_result(args.result)
+        if res.robot_sha256 and res.robot_sha256 != robot.sha256:
+            raise DataFileError(f"identified on another robot (robot_sha256 {res.robot_sha256[:12]}..., "
+                                f"{robot.sha256[:12]}... for {robot.source}): pass the same --robot as to identify",
+                                where=args.result)
+        big = np.abs(res.zero_offsets_deg) > args.max_offset_deg
+        if np.any(big):
+            j = int(np.flatnonzero(big)[0])
+            raise DataFileError(f"zero offset theta{j + 1} = {res.zero_offsets_deg[j]:g} deg exceeds "
+                                f"--max-offset-deg {args.max_offset_deg:g}: not a zero offset (check the result)",
+                                where=args.result)
+        offsets = res.zero_offsets_deg
+    else:
+        res, offsets = None, np.zeros(2)
+    meta = {"robot_sha256": robot.sha256}
+    if args.result is not None:
+        meta["result"] = args.result
+    if not has_poses:
+        text, what, K = data.format_compensation(res, {"result": args.result}), "compensation table", 0
+    else:
+        if args.poses is not None:
+            P = data.load_poses(args.poses, robot)
+        else:
+            from zerocal_sym.scheme import paper_poses
+
+            P = paper_poses(robot, args.n)
+        nominal, cmd = data.compensated_commands(robot, P, offsets)
+        K = len(P)
+        if args.template:
+            meta["compensation_deg"] = f"{float(offsets[0])!r}, {float(offsets[1])!r}"
+            text, what = data.format_template(cmd, P, meta), "measurement template"
+        else:
+            text, what = data.format_commands(P, nominal, cmd, offsets, meta), "compensated commands"
+    if args.out:
+        atomic_write_text(args.out, text)
+    if args.json:
+        print(to_json({"zero_offsets_deg": [float(v) for v in offsets], "sign_convention": data.SIGN_CONVENTION,
+                       "output": args.out, "kind": what, "poses": K}))
+    elif args.out:
+        print(f"wrote {what} ({K} poses) to {args.out}" if K else f"wrote {what} to {args.out}")
+        print(f"offsets [deg]: theta1 {offsets[0]:+.6f}, theta2 {offsets[1]:+.6f}; {data.SIGN_CONVENTION}")
+    else:
+        print(text, end="")
+    return 0
