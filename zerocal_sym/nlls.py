@@ -1,0 +1,418 @@
+"""Nonlinear (maximum-likelihood / MAP) identification with CasADi and Ipopt.
+
+The model is the exact distance-change model of the generated mechanism (no
+linearisation)::
+
+    s_k = rho(theta_cmd_{k+1}; e) - rho(theta_cmd_k; e) + noise,   k = 1..K-1
+
+with ``e`` the 12 source errors (rad, mm), of which the parameters selected by
+``params`` are estimated and the others held at ``prior`` (default zero).
+
+Weighting (errors-in-variables, marginalised to first order)
+    The servo error ``xi`` on the joints is not a latent variable here: it is
+    propagated through the kinematics into the covariance of the changes,
+    ``C = Cov(s) = sigma_m^2 I + D diag(sigma_xi^2 |d rho/d theta|^2) D^T``
+    (:func:`zerocal_sym.fisher.measurement_covariance`; consecutive changes
+    are correlated because they share a pose).  The residuals are whitened by
+    the inverse Cholesky factor of ``C``, evaluated at the initial point and
+    re-evaluated once at the solution (``reweight=1``), so the cost is
+    ``0.5 |L^-1 (s - s(p))|^2`` (+ prior terms): a Gaussian negative
+    log-likelihood whose Gauss-Newton Hessian is the Fisher information used
+    by :mod:`zerocal_sym.fisher`.
+
+Scaling
+    The optimisation variable is ``z = c * p`` with ``c = L_i`` (mm/rad) for
+    the zero offsets (the arc ``L_i dtheta_i``, the paper's ``dq``) and 1 for
+    lengths (:func:`zerocal_sym.fisher.parameter_scale`), so every variable
+    is in mm; the whitened residuals are in units of their standard deviation.
+
+Hessian
+    Ipopt gets the Gauss-Newton Hessian ``J^T J + diag(w^2)`` of the
+    least-squares cost through nlpsol's ``hess_lag`` option (as in CasADi's
+    ``sysid.py`` example); ``J`` is the CasADi Jacobian of the whitened
+    residuals.
+
+Priors and bounds
+    Optional Gaussian prior per parameter (``prior`` mean, ``prior_std``, in
+    rad / mm): the estimate is then the MAP.  Optional bounds in the same
+    units.  The NLP is built once per (mechanism, K, parameter set) and cached:
+    data, weights, geometry, fixed errors and priors are NLP parameters.
+"""
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+
+from zerocal_sym import fisher
+from zerocal_sym.errors import IdentificationError
+from zerocal_sym.measurement import SOURCE_ERROR_NAMES, NoiseModel
+from zerocal_sym.results import IdentificationResult
+
+#: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
+UNIT_SIGMA_MM = 1e-3
+#: Ipopt options (silenced)
+IPOPT_OPTIONS = {
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-10,
+    "ipopt.acceptable_tol": 1e-7,
+    "ipopt.nlp_scaling_method": "none",
+    "ipopt.max_iter": 200,
+    "print_time": False,
+}
+#: relative threshold on singular values of the scaled, whitened Jacobian
+RANK_RTOL = 1e-9
+
+_CACHE: dict = {}
+_LOCK = threading.Lock()
+
+
+class _Problem:
+    """One cached NLP for (mechanism, K, parameter indices)."""
+
+    def __init__(self, mechanism, K: int, idx: tuple):
+        import casadi as ca
+
+        self.K, self.idx, self.n = K, idx, len(idx)
+        m = K - 1
+        f = mechanism["distance"]
+        z = ca.SX.sym("z", self.n)
+        th = ca.SX.sym("theta", 2, K)
+        g = ca.SX.sym("g", f.size1_in(1))
+        efix = ca.SX.sym("err_fixed", f.size1_in(2))
+        s = ca.SX.sym("s", m)
+        W = ca.SX.sym("W", m, m)
+        sc = ca.SX.sym("scale", self.n)   # p = z / sc
+        mu = ca.SX.sym("prior_mean", self.n)
+        w = ca.SX.sym("prior_w", self.n)  # 1/std (physical), 0 = no prior
+        c = ca.SX.sym("obj_scale")        # objective scaling (GN Hessian of norm ~1)
+        # the full error vector: fixed values, the estimated ones replacing theirs
+        E = np.zeros((f.size1_in(2), self.n))
+        E[list(idx), range(self.n)] = 1.0
+        keep = np.ones(f.size1_in(2))
+        keep[list(idx)] = 0.0
+        p = z / sc
+        err = keep * efix + ca.mtimes(ca.DM(E), p)
+        rho = f.map(K)(th, g, err)            # 1 x K
+        pred = (rho[0, 1:] - rho[0, :-1]).T   # m x 1
+        r = ca.mtimes(W, s - pred)
+        rp = w * (p - mu)
+        res = ca.vertcat(r, rp)
+        J = ca.jacobian(res, z)
+        par = ca.vertcat(ca.vec(th), g, efix, s, ca.vec(W), sc, mu, w, c)
+        self.npar = par.numel()
+        cost = 0.5 * c * ca.dot(res, res)
+        nlp = {"x": z, "p": par, "f": cost}
+        sigma = ca.SX.sym("lam_f")
+        lam_g = ca.SX.sym("lam_g", 0)
+        H = ca.triu(sigma * c * ca.mtimes(J.T, J))
+        hess = ca.Function("nlp_hess_l", [z, par, sigma, lam_g], [H],
+                           ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])
+        self._nlp, self._hess, self._solvers = nlp, hess, {}
+        self.solver = self.solver_for(None)
+        self.resfun = ca.Function("residuals", [z, par], [r, rp, J, pred],
+                                  ["z", "p"], ["r", "r_prior", "J", "pred"])
+
+    def solver_for(self, max_iter):
+        """The Ipopt solver with this iteration limit (None: the default), built once."""
+        import casadi as ca
+
+        if max_iter not in self._solvers:
+            opts = dict(IPOPT_OPTIONS, hess_lag=self._hess)
+            if max_iter is not None:
+                opts["ipopt.max_iter"] = int(max_iter)
+            self._solvers[max_iter] = ca.nlpsol("nlls", "ipopt", self._nlp, opts)
+        return self._solvers[max_iter]
+
+    def pack(self, theta_cmd, geometry, err_fixed, s, W, scale, mu, w, obj_scale=1.0):
+        """The NLP parameter vector; ``theta_cmd`` shape (K, 2), ``W`` shape (K-1, K-1)."""
+        return np.concatenate([np.asarray(theta_cmd, float).ravel(), geometry, err_fixed, s,
+                               np.asarray(W, float).ravel(order="F"), scale, mu, w, [obj_scale]])
+
+
+def get_problem(robot, K: int, params="paper") -> _Problem:
+    """The cached NLP for ``K`` poses and the parameter set (built on first use)."""
+    idx = tuple(fisher.param_indices(params))
+    key = (robot.mechanism_name, K, idx)
+    with _LOCK:
+        prob = _CACHE.get(key)
+        if prob is None:
+            prob = _CACHE[key] = _Problem(robot.mechanism, K, idx)
+    return prob
+
+
+def _as_vector(x, n, what):
+    a = np.asarray(x, float).ravel()
+    if a.shape != (n,):
+        raise ValueError(f"{what}: expected {n} values, got {a.size}")
+    return a
+
+
+def _weights(robot, theta_cmd, noise, err):
+    if noise.is_zero:
+        return np.eye(theta_cmd.shape[0] - 1) / UNIT_SIGMA_MM
+    return fisher.whitener(fisher.measurement_covariance(robot, theta_cmd, noise, err))
+
+
+def _bounds(bounds, names, scale):
+    n = len(names)
+    lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
+    if bounds is None:
+        return lo, hi
+    if isinstance(bounds, dict):
+        for k, (a, b) in bounds.items():
+            if k not in names:
+                raise ValueError(f"bounds given for {k!r}, which is not estimated ({', '.join(names)})")
+            lo[names.index(k)], hi[names.index(k)] = a, b
+    else:
+        b = np.asarray(bounds, float)
+        if b.shape != (n, 2):
+            raise ValueError(f"bounds: expected shape ({n}, 2), got {b.shape}")
+        lo, hi = b[:, 0].copy(), b[:, 1].copy()
+    if np.any(lo > hi):
+        raise ValueError("bounds: lower bound above upper bound")
+    return lo * scale, hi * scale
+
+
+def _initial(robot, meas, params, names, prior12, warm_start):
+    """Initial guess (physical units, shape (p,)) and a note on where it came from."""
+    idx = fisher.param_indices(params)
+    x0 = prior12[idx].copy()
+    if warm_start is None:
+        return x0, "prior"
+    if isinstance(warm_start, str):
+        if warm_start != "tsvd":
+            raise ValueError(f"warm_start must be 'tsvd', None or an array, got {warm_start!r}")
+        try:
+            from zerocal_sym.tsvd import identify_tsvd
+        except ImportError:
+            return x0, "prior (tsvd unavailable)"
+        try:
+            ts = identify_tsvd(robot, meas, prior=prior12)
+        except Exception as exc:  # noqa: BLE001 - a failed warm start is not fatal
+            return x0, f"prior (tsvd failed: {exc})"
+        for k, n in enumerate(names):
+            if n in ts.params and np.isfinite(ts.value(n)):
+                x0[k] = ts.value(n)
+        return x0, "tsvd"
+    return _as_vector(warm_start, len(idx), "warm_start"), "given"
+
+
+def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
+                  bounds=None, prior_std=None, warm_start="tsvd", reweight: int = 1,
+                  max_iter: int | None = None) -> IdentificationResult:
+    """Maximum-likelihood (or MAP) identification with Ipopt on the exact model.
+
+    Parameters
+    ----------
+    robot : Robot
+    meas : Measurements
+        ``theta_cmd`` (K, 2) rad and ``readings`` (K,) mm (``readings[0] = 0``).
+    params : str or sequence of str
+        Parameters to estimate (see :func:`zerocal_sym.fisher.param_indices`):
+        ``"paper"`` (theta1 theta2 rMx rMy), ``"all"``, ``"paper+L1,L2"``, ...
+    noise : NoiseModel, optional
+        Weights and covariance (default: the paper's noise model).  A zero
+        model weights every change equally (1 um) and estimates the
+        covariance from the residuals.
+    prior : ndarray, shape (12,), optional
+        Current belief about the total source errors (rad, mm): the values
+        of the parameters not estimated, the mean of the Gaussian prior of
+        those estimated (with ``prior_std``) and the initial guess when
+        ``warm_start`` is None.  Default zero.
+    bounds : dict name -> (lo, hi) or ndarray, shape (p, 2), optional
+        rad / mm.
+    prior_std : ndarray, shape (p,) or dict name -> std, optional
+        Gaussian prior std (rad / mm); ``inf`` for none.
+    warm_start : "tsvd", None or ndarray, shape (p,)
+        ``"tsvd"``: start from the truncated-SVD estimate (if
+        :mod:`zerocal_sym.tsvd` is available, else from ``prior``).
+    reweight : int
+        Re-evaluate the weights at the solution and solve again this many
+        times (the covariance of the changes depends weakly on the estimate).
+    max_iter : int, optional
+        Ipopt iteration limit (default 200).
+
+    Returns
+    -------
+    IdentificationResult
+        ``method = "nlls"``; ``success`` False whenever Ipopt did not
+        converge (``status`` says why); ``info``: ``solver_status``,
+        ``iterations``, ``cost``, ``time_s``, ``weighting``, ``warm_start``,
+        ``rank``, ``singular_values`` (of the scaled whitened Jacobian),
+        ``nonidentifiable``.
+    """
+    t0 = time.perf_counter()
+    noise = NoiseModel.paper() if noise is None else noise
+    names = fisher.param_names(params)
+    idx = fisher.param_indices(params)
+    theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
+    K = theta_cmd.shape[0]
+    if K < 2:
+        raise IdentificationError(f"need at least 2 poses, got {K}")
+    s = np.asarray(meas.readings, float)[1:]
+    prior12 = np.zeros(len(SOURCE_ERROR_NAMES)) if prior is None else _as_vector(prior, 12, "prior")
+    scale = fisher.parameter_scale(robot, names)
+    if prior_std is None:
+        w = np.zeros(len(names))
+    else:
+        if isinstance(prior_std, dict):
+            std = np.full(len(names), np.inf)
+            for k, v in prior_std.items():
+                std[names.index(k)] = v
+        else:
+            std = _as_vector(prior_std, len(names), "prior_std")
+        if np.any(std <= 0):
+            raise ValueError("prior_std must be positive (inf for no prior)")
+        w = 1.0 / std
+    mu = prior12[idx]
+    lbx, ubx = _bounds(bounds, list(names), scale)
+    x0, start = _initial(robot, meas, names, names, prior12, warm_start)
+    z0 = np.clip(x0 * scale, lbx, ubx)
+
+    prob = get_problem(robot, K, names)
+    solver = prob.solver_for(max_iter)
+
+    def full(p):
+        e = prior12.copy()
+        e[idx] = p
+        return e
+
+    total_iter, stats = 0, {}
+    z = z0
+    for rnd in range(1 + max(0, int(reweight))):
+        W = _weights(robot, theta_cmd, noise, full(z / scale))
+        par = prob.pack(theta_cmd, robot.geometry, prior12, s, W, scale, mu, w)
+        J0 = prob.resfun(z, par)[2].full()
+        par[-1] = 1.0 / max(1e-300, np.linalg.norm(J0, 2) ** 2)
+        sol = solver(x0=z, p=par, lbx=lbx, ubx=ubx)
+        stats = solver.stats()
+        total_iter += int(stats.get("iter_count", 0))
+        zn = sol["x"].full().ravel()
+        if not stats.get("success", False):
+            z = zn
+            break
+        moved = np.max(np.abs(zn - z)) if rnd else np.inf
+        z = zn
+        if rnd and moved < 1e-9:
+            break
+    ret = str(stats.get("return_status", "unknown"))
+    converged = bool(stats.get("success", False)) and np.all(np.isfinite(z))
+    p_hat = z / scale
+    W = _weights(robot, theta_cmd, noise, full(p_hat))
+    par = prob.pack(theta_cmd, robot.geometry, prior12, s, W, scale, mu, w)
+    r, rp, J, pred = (o.full() for o in prob.resfun(z, par))
+    r, rp = r.ravel(), rp.ravel()
+    Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
+    F = J.T @ J      # data + prior information, scaled units
+    sv = np.linalg.svd(Jd, compute_uv=False) if Jd.size else np.zeros(0)
+    U, sF, Vt = np.linalg.svd(F)
+    tol = RANK_RTOL * (sF[0] if sF.size else 0.0)
+    rank = int(np.sum(sF > tol))
+    null = Vt[rank:]
+    if noise.is_zero:
+        dof = (K - 1) - rank
+        s2 = float(r @ r) * UNIT_SIGMA_MM**2 / dof if dof > 0 else np.nan
+    else:
+        s2 = 1.0
+    Finv = (Vt[:rank].T / sF[:rank]) @ Vt[:rank]
+    cov = s2 * Finv / np.outer(scale, scale)
+    nonid = []
+    for v in null:
+        v = v / scale  # direction in physical units
+        v = v / np.max(np.abs(v))
+        nonid.append({n: float(c) for n, c in zip(names, v) if abs(c) > 1e-6})
+    for k in range(len(names)):  # non-identifiable parameters get infinite variance
+        if null.size and np.max(np.abs(null[:, k])) > 1e-6:
+            cov[k, :] = np.nan
+            cov[:, k] = np.nan
+            cov[k, k] = np.inf
+    offsets_ok = all(not (null.size and np.max(np.abs(null[:, names.index(n)])) > 1e-6)
+                     for n in ("theta1", "theta2") if n in names)
+    success = converged and offsets_ok
+    if not converged:
+        status = f"Ipopt did not converge: {ret}"
+    elif not offsets_ok:
+        status = (f"converged ({ret}) but the zero offsets are not identifiable from these poses "
+                  f"with parameters {', '.join(names)} (rank {rank} of {len(names)})")
+    elif rank < len(names):
+        status = (f"converged ({ret}); rank {rank} of {len(names)}: some geometric combinations are "
+                  "not identifiable (see info['nonidentifiable'])")
+    else:
+        status = f"converged ({ret})"
+    info = {
+        "solver_status": ret,
+        "iterations": total_iter,
+        "cost": 0.5 * float(r @ r + rp @ rp),
+        "chi2": float(r @ r),
+        "dof": (K - 1) - len(names),
+        "time_s": time.perf_counter() - t0,
+        "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
+                      "errors-in-variables: whitened by chol(Cov(s)), servo error propagated"),
+        "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
+        "warm_start": start,
+        "initial": x0.tolist(),
+        "rank": rank,
+        "singular_values": sv.tolist(),
+        "nonidentifiable": nonid,
+        "scale_mm_per_unit": scale.tolist(),
+        "prior": prior12.tolist(),
+    }
+    return IdentificationResult(method="nlls", params=names, estimate=p_hat,
+                                covariance=cov, success=bool(success), status=status,
+                                residuals=np.asarray(s - pred.ravel()), info=info)
+
+
+def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, **kwargs):
+    """An ``identify(robot, meas, prior12)`` callable for the calibration loop.
+
+    Parameters
+    ----------
+    params, noise, **kwargs
+        Passed to :func:`identify_nlls`.
+
+    Returns
+    -------
+    callable
+        ``identify(robot, meas, prior) -> IdentificationResult``.
+    """
+    def identify(robot, meas, prior=None):
+        return identify_nlls(robot, meas, params=params, noise=noise, prior=prior, **kwargs)
+
+    identify.__name__ = f"nlls[{params}]"
+    return identify
+
+
+def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None):
+    """The same whitened, scaled least-squares problem as numpy callables.
+
+    For outside solvers (``scipy.optimize.least_squares``) on exactly the
+    problem Ipopt solves (weights at ``prior``, no bounds or priors).
+
+    Returns
+    -------
+    fun : callable z -> ndarray, shape (K-1,)
+    jac : callable z -> ndarray, shape (K-1, p)
+    scale : ndarray, shape (p,)
+        ``p = z / scale`` (physical units).
+    """
+    noise = NoiseModel.paper() if noise is None else noise
+    names = fisher.param_names(params)
+    idx = fisher.param_indices(params)
+    theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
+    K = theta_cmd.shape[0]
+    prior12 = np.zeros(12) if prior is None else _as_vector(prior, 12, "prior")
+    scale = fisher.parameter_scale(robot, names)
+    W = _weights(robot, theta_cmd, noise, prior12)
+    prob = get_problem(robot, K, names)
+    par = prob.pack(theta_cmd, robot.geometry, prior12, np.asarray(meas.readings, float)[1:], W, scale,
+                    prior12[idx], np.zeros(len(names)))
+    import casadi as ca
+
+    zs = ca.SX.sym("z", len(names))
+    r, _, J, _ = prob.resfun(zs, ca.DM(par))
+    fr = ca.Function("r", [zs], [r])
+    fj = ca.Function("J", [zs], [J[: K - 1, :]])
+    return (lambda z: fr(z).full().ravel()), (lambda z: fj(z).full()), scale
