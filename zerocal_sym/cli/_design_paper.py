@@ -1,0 +1,90 @@
+"""``zerocal design --scheme paper``: the paper's pose scheme (Section 5).
+
+Prints the 2n poses, ``kappa_1`` (first identification, no MAEMM prior),
+``kappa_m`` (with the MAEMM prior, Eq. 30), ``eps = (kappa_1 - kappa_m) /
+kappa_1``, what the eps rule (Eq. 31) selects, the condition numbers for the
+other readings of the paper's prior, and the Cramér-Rao bound of each zero
+offset under the paper's noise model (and under the scale error alone).
+
+Default ``--maemm-prior``: ``(1, -0.5)`` mm, the paper's ``(1, 0.5)`` read in the
+paper's frame, which is ours mirrored about the x axis (docs/reproduction.md).
+"""
+from __future__ import annotations
+
+
+def run(args):
+    import numpy as np
+
+    from zerocal_sym import kinematics as kin
+    from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.errors import PoseError, ZerocalError
+    from zerocal_sym.fisher import crlb_zero_offsets_deg
+    from zerocal_sym.io import to_json
+    from zerocal_sym.measurement import NoiseModel
+    from zerocal_sym.paper import (DEFAULT_MAEMM_PRIOR, MAEMM_PRIOR_READINGS, PAPER_KAPPA_1, PAPER_KAPPA_M,
+                                   kappas, select_n)
+    from zerocal_sym.scheme import identification_matrix, paper_poses
+
+    robot = load_robot_arg(args)
+    prior = tuple(float(v) for v in args.maemm_prior) if args.maemm_prior else DEFAULT_MAEMM_PRIOR
+    if not all(np.isfinite(prior)):
+        raise ZerocalError("--maemm-prior must be finite numbers (mm)")
+    if args.n is not None and args.n < 3:
+        raise PoseError(f"--n {args.n} gives K = {2 * args.n} < 5 poses: the 4 parameters are not identifiable "
+                        "(n >= 3 needed)")
+    rule_error = None
+    try:
+        sel = select_n(robot, args.eps0, prior)
+    except ZerocalError as exc:
+        if args.n is None:
+            raise
+        sel, rule_error = None, str(exc)
+    n = args.n if args.n is not None else sel.n
+    P = paper_poses(robot, n)
+    theta = kin.check_poses(robot, P, in_workspace=True)
+    k1, km = kappas(robot, n, prior)
+    eps = (k1 - km) / k1
+    s = np.linalg.svd(identification_matrix(robot, P, prior)[0], compute_uv=False)
+    crlb = crlb_zero_offsets_deg(robot, theta, "paper", NoiseModel.paper())
+    crlb_scale = crlb_zero_offsets_deg(robot, theta, "paper", NoiseModel.named("scale-only"))
+    readings = {label: kappas(robot, n, pr)[1] for label, pr in MAEMM_PRIOR_READINGS.items()}
+    out = {
+        "scheme": "paper",
+        "robot": robot.name,
+        "n": n,
+        "K": 2 * n,
+        "poses": P.tolist(),
+        "joints_deg": np.degrees(theta).tolist(),
+        "kappa_1": k1,
+        "kappa_m": km,
+        "eps": eps,
+        "eps0": args.eps0,
+        "selected_by": "--n" if args.n is not None else "eps0 rule",
+        "eps_rule_n": None if sel is None else sel.n,
+        "eps_rule_error": rule_error,
+        "eps_table": None if sel is None else sel.table,
+        "maemm_prior_mm": list(prior),
+        "kappa_m_readings": {label: {"maemm_prior_mm": list(pr), "kappa_m": readings[label]}
+                             for label, pr in MAEMM_PRIOR_READINGS.items()},
+        "singular_values_with_prior": s.tolist(),
+        "crlb_zero_offsets_deg": crlb.tolist(),
+        "crlb_noise": "paper (Eq. 34 scale + Eq. 35 servo)",
+        "crlb_zero_offsets_deg_scale_only": crlb_scale.tolist(),
+    }
+    if robot.name == "paper":
+        out["paper"] = {"n": 3, "kappa_1": PAPER_KAPPA_1, "kappa_m": PAPER_KAPPA_M}
+    if args.json:
+        print(to_json(out))
+        return 0
+    print(f"paper scheme on robot {robot.name}: n = {n} poses per boundary, K = {2 * n} "
+          f"({out['selected_by']}; eps0 rule selects n = {out['eps_rule_n']} with eps0 = {args.eps0:g})")
+    for k, ((x, y), (t1, t2)) in enumerate(zip(P, np.degrees(theta)), 1):
+        print(f"  P{k:<2d} ({x:8.3f}, {y:8.3f}) mm   theta = ({t1:9.4f}, {t2:9.4f}) deg")
+    pk = "  (paper: 475.34, 472.54)" if robot.name == "paper" and n == 3 else ""
+    print(f"kappa_1 = {k1:.3f}, kappa_m = {km:.3f} with MAEMM prior {prior} mm, eps = {eps:.5f}{pk}")
+    print("kappa_m for the readings of the paper's prior (1, 0.5) mm:")
+    for label, pr in MAEMM_PRIOR_READINGS.items():
+        print(f"  {label:40s} prior {pr} mm in our frame: kappa_m = {readings[label]:.3f}")
+    print(f"CRLB of the zero offsets: {crlb[0]:.4f} / {crlb[1]:.4f} deg (paper noise: scale + servo), "
+          f"{crlb_scale[0]:.4f} / {crlb_scale[1]:.4f} deg (scale error alone)")
+    return 0
