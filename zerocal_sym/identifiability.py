@@ -134,11 +134,12 @@ def to_base_gauge(robot, err) -> np.ndarray:
     A2n = np.array([robot.param("e2x"), robot.param("e2y")])
     d, dn = A2 - A1, A2n - A1n
     angle = np.arctan2(dn[1], dn[0]) - np.arctan2(d[1], d[0])
+    angle = (angle + np.pi) % (2 * np.pi) - np.pi
     c, s = np.cos(angle), np.sin(angle)
     shift = A1n - np.array([[c, -s], [s, c]]) @ A1
     out = rigid_motion(robot, err, angle, shift)
-    out[[_ix(n) for n in BASE_GAUGE]] = np.where(np.abs(out[[_ix(n) for n in BASE_GAUGE]]) < 1e-12, 0.0,
-                                                  out[[_ix(n) for n in BASE_GAUGE]])
+    gauge = [_ix(n) for n in BASE_GAUGE]
+    out[gauge] = np.where(np.abs(out[gauge]) < 1e-12, 0.0, out[gauge])  # exact zeros, not round-off
     return out
 
 
