@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/planar_2dof.py
-inputs hash: 32a23a6fa01ea5ac
+inputs hash: d7b3cdff5887eb71
 sympy: 1.14.0
 """
 import casadi as ca
