@@ -47,6 +47,8 @@ DEFAULT_RULE = "threshold"
 DEFAULT_RTOL = 1e-6
 #: G with sigma_min / sigma_max below this is treated as rank-deficient (collinear poses).
 RANK_RTOL = 1e-9
+#: poses whose second principal extent is below this fraction of the first are "on one line".
+COLLINEAR_RTOL = 1e-6
 PARAMS = ("theta1", "theta2", "rMx", "rMy")
 
 
@@ -229,7 +231,8 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     ------
     IdentificationError
         K < 5, a non-finite reading or angle (naming the pose), G of rank < 4
-        (collinear measuring-mechanism vectors).
+        (collinear measuring-mechanism vectors), poses on one straight line
+        (G nearly rank-deficient, condition number ~1e4-1e5).
     PoseError
         A commanded pose that is not an assembly of the robot.
     """
@@ -254,7 +257,13 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         rank = int(np.sum(s > RANK_RTOL * s[0]))
         raise IdentificationError(
             f"identification matrix G has rank {rank} < 4: the measuring-mechanism vectors of the poses "
-            "are (nearly) collinear, the offsets and the MAEMM cannot be identified", where=meas.source)
+            "are collinear, the offsets and the MAEMM cannot be identified", where=meas.source)
+    spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
+    if spread[1] <= COLLINEAR_RTOL * spread[0]:
+        raise IdentificationError(
+            f"the {P.shape[0]} poses lie on one straight line: G is nearly rank-deficient (condition number "
+            f"{s[0] / s[-1]:.3g}); use poses that span the workspace (e.g. the paper's two boundaries)",
+            where=meas.source)
     C = None
     if noise is not None:
         C = measurement_covariance(robot, th, noise, err0=prior)

@@ -39,7 +39,8 @@ def _progress(total):
     import sys
     import time
 
-    state = {"t0": time.perf_counter(), "last": 0.0}
+    t0 = time.perf_counter()
+    state = {"t0": t0, "last": t0}
 
     def report(done, _total):
         now = time.perf_counter()
@@ -71,6 +72,11 @@ def _write_out(out_dir, rep, robot, n):
         fig8(tmp / "fig8.png", d8)
         fig9(tmp / "fig9.png", rep["groups"], rep["settings"]["mu0_deg"])
         write_json(tmp / "results.json", dict(rep, fig8=d8))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)
+        for name in ("fig8.png", "fig9.png", "results.json"):
+            os.chmod(tmp / name, 0o666 & ~umask)
         if not out.exists():
             os.rename(tmp, out)
         else:
@@ -104,6 +110,11 @@ def run(args):
     identify = functools.partial(identify_tsvd, t=args.truncation, rule=args.rule,
                                  noise=NoiseModel.named(args.noise))
     identify.__name__ = f"identify_tsvd(t={args.truncation}, rule={args.rule})"
+    if args.out:
+        from pathlib import Path
+
+        if Path(args.out).exists() and not Path(args.out).is_dir():
+            raise ZerocalError("--out exists and is not a directory", where=args.out)
     total = 6 * args.trials
     progress = _progress(total) if total > 6 else None
     rep = reproduce(robot, seed=args.seed, trials=args.trials, noise=args.noise, n=args.n, frame=args.frame,
