@@ -28,6 +28,20 @@ def add_arguments(p):
     p.add_argument("--verify", type=int, default=0, metavar="N", help="Monte Carlo trials to verify the CRLB")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot the poses in the workspace")
     p.add_argument("--json", action="store_true", help="print JSON")
+    # --optimize constraints and settings (issue 5; defaults in zerocal_sym.design)
+    p.add_argument("--l0", type=float, default=350.0, metavar="MM",
+                   help="scale range l0 in mm (--optimize; default 350, the paper's)")
+    p.add_argument("--travel-mode", choices=["range", "consecutive"], default="range",
+                   help="l0 bounds the span of rho over all poses (range, default) or each change (consecutive)")
+    p.add_argument("--margin", type=float, default=None,
+                   help="min |sin| of every transmission angle (--optimize; default: the robot's)")
+    p.add_argument("--joint-limits", nargs=4, type=float, metavar=("LO1", "HI1", "LO2", "HI2"), default=None,
+                   help="joint limits in deg (--optimize; default none)")
+    p.add_argument("--min-separation", type=float, default=1.0, metavar="MM",
+                   help="min distance between two poses in mm (--optimize; default 1)")
+    p.add_argument("--noise", choices=["paper", "scale-only", "servo-only"], default="paper",
+                   help="noise model of the Fisher-information criteria (--optimize; default paper)")
+    p.add_argument("--starts", type=int, default=8, help="random Ipopt starts and exchange starts (--optimize)")
 
 
 def run(args):
