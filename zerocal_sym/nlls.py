@@ -86,7 +86,7 @@ class _Problem:
         W = ca.SX.sym("W", m, m)
         sc = ca.SX.sym("scale", self.n)   # p = z / sc
         mu = ca.SX.sym("prior_mean", self.n)
-        w = ca.SX.sym("prior_w", self.n)  # 1/std (physical), 0 = no prior
+        w = ca.SX.sym("prior_W", self.n, self.n)  # prior whitener (physical), 0 = no prior
         c = ca.SX.sym("obj_scale")        # objective scaling (GN Hessian of norm ~1)
         # the full error vector: fixed values, the estimated ones replacing theirs
         E = np.zeros((f.size1_in(2), self.n))
@@ -98,10 +98,10 @@ class _Problem:
         rho = f.map(K)(th, g, err)            # 1 x K
         pred = (rho[0, 1:] - rho[0, :-1]).T   # m x 1
         r = ca.mtimes(W, s - pred)
-        rp = w * (p - mu)
+        rp = ca.mtimes(w, p - mu)
         res = ca.vertcat(r, rp)
         J = ca.jacobian(res, z)
-        par = ca.vertcat(ca.vec(th), g, efix, s, ca.vec(W), sc, mu, w, c)
+        par = ca.vertcat(ca.vec(th), g, efix, s, ca.vec(W), sc, mu, ca.vec(w), c)
         self.npar = par.numel()
         cost = 0.5 * c * ca.dot(res, res)
         nlp = {"x": z, "p": par, "f": cost}
@@ -114,6 +114,8 @@ class _Problem:
         self.solver = self.solver_for(None)
         self.resfun = ca.Function("residuals", [z, par], [r, rp, J, pred],
                                   ["z", "p"], ["r", "r_prior", "J", "pred"])
+        self.rfun = ca.Function("r", [z, par], [r])
+        self.jfun = ca.Function("J", [z, par], [ca.jacobian(r, z)])
 
     def solver_for(self, max_iter):
         """The Ipopt solver with this iteration limit (None: the default), built once."""
@@ -127,9 +129,14 @@ class _Problem:
         return self._solvers[max_iter]
 
     def pack(self, theta_cmd, geometry, err_fixed, s, W, scale, mu, w, obj_scale=1.0):
-        """The NLP parameter vector; ``theta_cmd`` shape (K, 2), ``W`` shape (K-1, K-1)."""
+        """The NLP parameter vector.
+
+        ``theta_cmd`` shape (K, 2), ``W`` shape (K-1, K-1), ``w`` (prior
+        whitener) shape (p, p).
+        """
         return np.concatenate([np.asarray(theta_cmd, float).ravel(), geometry, err_fixed, s,
-                               np.asarray(W, float).ravel(order="F"), scale, mu, w, [obj_scale]])
+                               np.asarray(W, float).ravel(order="F"), scale, mu,
+                               np.asarray(w, float).ravel(order="F"), [obj_scale]])
 
 
 def get_problem(robot, K: int, params="paper") -> _Problem:
@@ -202,7 +209,7 @@ def _initial(robot, meas, params, names, prior12, warm_start):
 
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
                   bounds=None, prior_std=None, warm_start="tsvd", reweight: int = 1,
-                  max_iter: int | None = None) -> IdentificationResult:
+                  max_iter: int | None = None, prior_cov=None) -> IdentificationResult:
     """Maximum-likelihood (or MAP) identification with Ipopt on the exact model.
 
     Parameters
@@ -226,6 +233,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         rad / mm.
     prior_std : ndarray, shape (p,) or dict name -> std, optional
         Gaussian prior std (rad / mm); ``inf`` for none.
+    prior_cov : ndarray, shape (p, p), optional
+        Full Gaussian prior covariance instead of ``prior_std``.
     warm_start : "tsvd", None or ndarray, shape (p,)
         ``"tsvd"``: start from the truncated-SVD estimate (if
         :mod:`zerocal_sym.tsvd` is available, else from ``prior``).
@@ -255,8 +264,18 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     s = np.asarray(meas.readings, float)[1:]
     prior12 = np.zeros(len(SOURCE_ERROR_NAMES)) if prior is None else _as_vector(prior, 12, "prior")
     scale = fisher.parameter_scale(robot, names)
-    if prior_std is None:
-        w = np.zeros(len(names))
+    if prior_cov is not None:
+        if prior_std is not None:
+            raise ValueError("give prior_std or prior_cov, not both")
+        pc = np.asarray(prior_cov, float)
+        if pc.shape != (len(names), len(names)):
+            raise ValueError(f"prior_cov: expected shape ({len(names)}, {len(names)}), got {pc.shape}")
+        try:
+            w = fisher.whitener(pc)
+        except np.linalg.LinAlgError:
+            raise ValueError("prior_cov must be symmetric positive definite") from None
+    elif prior_std is None:
+        w = np.zeros((len(names), len(names)))
     else:
         if isinstance(prior_std, dict):
             std = np.full(len(names), np.inf)
@@ -266,7 +285,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             std = _as_vector(prior_std, len(names), "prior_std")
         if np.any(std <= 0):
             raise ValueError("prior_std must be positive (inf for no prior)")
-        w = 1.0 / std
+        w = np.diag(1.0 / std)
     mu = prior12[idx]
     lbx, ubx = _bounds(bounds, list(names), scale)
     x0, start = _initial(robot, meas, names, names, prior12, warm_start)
@@ -365,23 +384,42 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                                 residuals=np.asarray(s - pred.ravel()), info=info)
 
 
-def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, **kwargs):
+def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):
     """An ``identify(robot, meas, prior12)`` callable for the calibration loop.
 
     Parameters
     ----------
     params, noise, **kwargs
         Passed to :func:`identify_nlls`.
+    sequential : bool
+        Carry the information of earlier rounds: when ``prior`` is this
+        identifier's own previous estimate (as the calibration loop passes
+        it), that estimate's covariance is used as a Gaussian prior
+        (``prior_cov``), so round j's estimate is the MAP given all j rounds
+        (Gaussian approximation of the previous posterior).  Make a new
+        identifier per loop.
 
     Returns
     -------
     callable
         ``identify(robot, meas, prior) -> IdentificationResult``.
     """
-    def identify(robot, meas, prior=None):
-        return identify_nlls(robot, meas, params=params, noise=noise, prior=prior, **kwargs)
+    state = {"last": None}
 
-    identify.__name__ = f"nlls[{params}]"
+    def identify(robot, meas, prior=None):
+        kw = dict(kwargs)
+        last = state["last"]
+        if sequential and last is not None and prior is not None and last.success:
+            full = last.full_vector()
+            idx = fisher.param_indices(params)
+            if np.allclose(np.asarray(prior, float)[idx], full[idx], rtol=0, atol=1e-15) \
+                    and last.covariance is not None and np.all(np.isfinite(last.covariance)):
+                kw["prior_cov"] = last.covariance
+        res = identify_nlls(robot, meas, params=params, noise=noise, prior=prior, **kw)
+        state["last"] = res
+        return res
+
+    identify.__name__ = f"nlls[{params}]" + ("-sequential" if sequential else "")
     return identify
 
 
@@ -389,30 +427,26 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     """The same whitened, scaled least-squares problem as numpy callables.
 
     For outside solvers (``scipy.optimize.least_squares``) on exactly the
-    problem Ipopt solves (weights at ``prior``, no bounds or priors).
+    problem Ipopt solves with ``warm_start=None, reweight=0`` (weights at
+    ``prior``, no bounds, no Gaussian prior).
 
     Returns
     -------
     fun : callable z -> ndarray, shape (K-1,)
+        Whitened residuals.
     jac : callable z -> ndarray, shape (K-1, p)
     scale : ndarray, shape (p,)
-        ``p = z / scale`` (physical units).
+        ``p = z / scale`` (physical units); start at ``prior[params] * scale``.
     """
     noise = NoiseModel.paper() if noise is None else noise
     names = fisher.param_names(params)
     idx = fisher.param_indices(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
-    K = theta_cmd.shape[0]
-    prior12 = np.zeros(12) if prior is None else _as_vector(prior, 12, "prior")
+    prior12 = np.zeros(len(SOURCE_ERROR_NAMES)) if prior is None else _as_vector(prior, 12, "prior")
     scale = fisher.parameter_scale(robot, names)
     W = _weights(robot, theta_cmd, noise, prior12)
-    prob = get_problem(robot, K, names)
+    prob = get_problem(robot, theta_cmd.shape[0], names)
     par = prob.pack(theta_cmd, robot.geometry, prior12, np.asarray(meas.readings, float)[1:], W, scale,
-                    prior12[idx], np.zeros(len(names)))
-    import casadi as ca
-
-    zs = ca.SX.sym("z", len(names))
-    r, _, J, _ = prob.resfun(zs, ca.DM(par))
-    fr = ca.Function("r", [zs], [r])
-    fj = ca.Function("J", [zs], [J[: K - 1, :]])
-    return (lambda z: fr(z).full().ravel()), (lambda z: fj(z).full()), scale
+                    prior12[idx], np.zeros((len(names), len(names))))
+    rfun, jfun = prob.rfun, prob.jfun
+    return (lambda z: rfun(z, par).full().ravel()), (lambda z: jfun(z, par).full()), scale
