@@ -67,6 +67,9 @@ WORKSPACE_TOL_MM = 25.0
 #: a few degrees moves the platform by some 10 mm).
 TARGET_TOL_MM = 50.0
 MIN_POSES = 5
+#: plausibility limits of the cells (anything beyond is a unit or typing error)
+ANGLE_LIMIT_DEG = 3600.0
+LENGTH_LIMIT_MM = 1e6
 #: two poses whose commanded angles agree to this (deg) are the same pose
 DUPLICATE_TOL_DEG = 1e-9
 
@@ -313,6 +316,9 @@ def _number(text: str, where: str, col: str, j: int) -> float:
         raise DataFileError(f"{label}: {shown!r} is not a number", where=where) from None
     if not math.isfinite(v):
         raise DataFileError(f"{label}: {text} is not a finite number", where=where)
+    limit, unit = (ANGLE_LIMIT_DEG, "deg") if col.endswith("_deg") else (LENGTH_LIMIT_MM, "mm")
+    if col != "pose" and abs(v) > limit:
+        raise DataFileError(f"{label}: {v:g} is beyond the plausible range +-{limit:g} {unit}", where=where)
     return v
 
 
