@@ -1,10 +1,15 @@
 """Regenerate ``examples/measurements_example.csv`` (and the pose list ``examples/poses_example.csv``).
 
 A simulated measurement round of the paper's robot (Table 1): Table 2 group 1
-(zero offsets 2 and -1 deg, geometric errors "set A", MAEMM (1, 0.5) mm), the
-paper's six poses (``scheme.paper_poses(robot, 3)``, visiting order as in
-SPEC.md), the paper's noise (Eqs. 34-35) and seed 2017.  Run from the
-repository root::
+(zero offsets 2 and -1 deg, geometric errors "set A", MAEMM (1, 0.5) mm, read
+in the paper's frame as ``zerocal simulate`` does -- ours mirrored about the
+x axis, so the true offsets in the robot's frame are (-2, +1) deg and the
+MAEMM (1, -0.5) mm; see ``zerocal_sym/paper.py``), the paper's six poses
+(``scheme.paper_poses(robot, 3)``, visiting order as in SPEC.md), the paper's
+noise (Eqs. 34-35) and the random stream ``default_rng([2017, 1])``.  The
+readings are the same as those of
+``zerocal simulate --group 1 --seed 2017 --noise paper --n 3`` (only the
+metadata lines differ).  Run from the repository root::
 
     python examples/make_measurements_example.py
 
@@ -16,7 +21,8 @@ import numpy as np
 
 from zerocal_sym import data, kinematics, scheme
 from zerocal_sym.io import atomic_write_text
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.measurement import NoiseModel, VirtualPlant
+from zerocal_sym.paper import group_errors
 from zerocal_sym.robot import paper_robot
 
 HERE = Path(__file__).resolve().parent
@@ -35,11 +41,14 @@ def make_example():
     robot = paper_robot()
     P = scheme.paper_poses(robot, 3)
     theta = kinematics.ik(robot, P)
-    plant = VirtualPlant(robot, table2_errors(GROUP))
-    readings = plant.measure(theta, NoiseModel.paper(), np.random.default_rng(SEED))
+    err = group_errors(GROUP, "paper")
+    plant = VirtualPlant(robot, err)
+    readings = plant.measure(theta, NoiseModel.paper(), np.random.default_rng([SEED, GROUP]))
     meta = {"robot_sha256": robot.sha256,
-            "simulated": f"paper Table 2 group {GROUP}, noise paper, seed {SEED} "
-                         "(examples/make_measurements_example.py)"}
+            "simulated": f"paper Table 2 group {GROUP} (paper frame), noise paper, rng [{SEED}, {GROUP}] "
+                         "(examples/make_measurements_example.py)",
+            "true_zero_offsets_deg": " ".join(f"{v:.10g}" for v in np.degrees(err[:2])),
+            "true_maemm_mm": " ".join(f"{v:.10g}" for v in err[10:12])}
     return data.Measurements(theta, readings, P, meta)
 
 
