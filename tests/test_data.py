@@ -400,7 +400,7 @@ def test_load_poses(tmp_path, robot):
     p = write(tmp_path, "# my poses\nx_mm,y_mm\n-240,632\n0,700\n", "p.csv")
     np.testing.assert_array_equal(data.load_poses(p, robot), [[-240, 632], [0, 700]])
     p = write(tmp_path, "pose,x_mm,y_mm\n0,-240,632\n1,0,900\n", "p.csv")
-    with pytest.raises(DataFileError, match=r"p.csv:3: pose \(0, 900\) mm is outside the workspace"):
+    with pytest.raises(DataFileError, match=r"p.csv:3: pose 1 \(0, 900\) mm is outside the workspace"):
         data.load_poses(p, robot)
     p = write(tmp_path, "x_mm,z_mm\n1,2\n", "p.csv")
     with pytest.raises(DataFileError, match=r"p.csv:1: unexpected column"):
@@ -408,6 +408,12 @@ def test_load_poses(tmp_path, robot):
     p = write(tmp_path, "x_mm,y_mm\n", "p.csv")
     with pytest.raises(DataFileError, match=r"p.csv:1: no data rows"):
         data.load_poses(p)
+    # a design JSON (zerocal design --json)
+    p = write(tmp_path, json.dumps({"K": 2, "poses": [[-240, 632], [240, 782.0]]}, indent=1), "d.json")
+    np.testing.assert_array_equal(data.load_poses(p, robot), [[-240, 632], [240, 782]])
+    p = write(tmp_path, json.dumps({"K": 2, "poses": [[-240, 632], [240]]}, indent=1), "d.json")
+    with pytest.raises(DataFileError, match=r"d.json:3: key 'poses' must be a non-empty list of \[x_mm, y_mm\]"):
+        data.load_poses(p, robot)
 
 
 def _result_json(**over):

@@ -134,7 +134,7 @@ def test_result_loader(tmp_path, text):
 
 @FUZZ
 @given(text=st.text(alphabet=st.sampled_from(list("0123456789-.,e\n #xy_mposan")),
-                    max_size=120), header=st.sampled_from(["", "x_mm,y_mm\n", "pose,x_mm,y_mm\n", "y_mm,x_mm\n"]))
+                    max_size=120), header=st.sampled_from(["", "x_mm,y_mm\n", "pose,x_mm,y_mm\n", "y_mm,x_mm\n", '{"poses": ', "{"]))
 def test_pose_loader(tmp_path, text, header):
     p = tmp_path / "p.csv"
     p.write_text(header + text)

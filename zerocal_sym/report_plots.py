@@ -260,12 +260,13 @@ def convergence_data(history, set_values_deg=None) -> dict:
 
     Parameters
     ----------
-    history : sequence
-        One entry per identification round (a ``LoopResult.history``): each a
-        mapping or object with ``compensation_deg`` (2,) -- the compensation
-        value after that round (the sum of the increments), deg -- and
-        optionally ``mu_deg`` (the compensation accuracy). Entries may
-        instead give ``compensation`` in rad.
+    history : LoopResult, sequence or dict
+        A :class:`~zerocal_sym.paper.LoopResult` (its ``history``), a sequence
+        with one entry per identification round (mappings or objects with
+        ``compensation_deg`` (2,): the compensation value after that round,
+        i.e. the sum of the increments, deg; or ``compensation`` in rad), or
+        the ``history`` dict of :func:`zerocal_sym.paper.run_group` (a dict
+        with a list ``compensation_deg``).
     set_values_deg : array_like, shape (2,), optional
         True zero offsets (simulation): also ``delta_deg``, the absolute
         difference between the set and the compensation values.
@@ -276,6 +277,10 @@ def convergence_data(history, set_values_deg=None) -> dict:
         ``iteration`` (m,) 1..m, ``compensation_deg`` (m, 2), ``mu_deg`` (m,)
         (NaN for the first round), ``delta_deg`` (m, 2) or None.
     """
+    if hasattr(history, "history"):
+        history = history.history
+    if isinstance(history, dict):
+        history = [{"compensation_deg": c} for c in history["compensation_deg"]]
     comp = []
     for h in history:
         c = _get(h, "compensation_deg")
