@@ -678,7 +678,11 @@ def candidate_grid(robot, cons: Constraints, nx: int = 25, ny: int = 11):
     return grid[_pointwise_ok(robot, grid, cons)]
 
 
-def _feasible_random_subset(rng, rho, K, cons, tries=200):
+def _feasible_random_subset(rng, rho, K, cons, tries=200, close=None):
+    """Random ordered K-subset meeting the travel and separation constraints (None if not found).
+
+    ``close`` : bool ndarray, shape (N, N), pairs closer than the minimum separation.
+    """
     N = len(rho)
     for _ in range(tries):
         if cons.travel_mode == "range" and np.ptp(rho) > cons.travel_mm:
@@ -688,7 +692,18 @@ def _feasible_random_subset(rng, rho, K, cons, tries=200):
             pool = np.arange(N)
         if len(pool) < K:
             continue
-        idx = rng.choice(pool, K, replace=False)
+        if close is None:
+            idx = rng.choice(pool, K, replace=False)
+        else:  # greedy in random order
+            idx = []
+            for c in rng.permutation(pool):
+                if not idx or not np.any(close[c, idx]):
+                    idx.append(c)
+                    if len(idx) == K:
+                        break
+            if len(idx) < K:
+                continue
+            idx = rng.permutation(np.array(idx))
         if _travel_ok(rho[idx], cons):
             return idx
     return None
@@ -732,12 +747,16 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
     rho = t["rho"]
     rng = np.random.default_rng(seed)
     N = len(cand)
+    close = None
+    if cons.min_separation_mm > 0:
+        close = np.linalg.norm(cand[:, None] - cand[None], axis=2) < cons.min_separation_mm
+        np.fill_diagonal(close, False)
     best_idx, best_o, starts = None, np.inf, []
     for _ in range(n_starts):
-        idx = _feasible_random_subset(rng, rho, K, cons)
+        idx = _feasible_random_subset(rng, rho, K, cons, close=close)
         if idx is None:
             raise DesignError(f"no {K} candidate poses fit the scale travel l0 = {cons.travel_mm:g} mm "
-                              f"({cons.travel_mode})")
+                              f"({cons.travel_mode}) and the minimum separation {cons.min_separation_mm:g} mm")
         cur = _objective_batch(criterion, aq_all[idx][None], v_all[idx][None], sm2, qs)[0]
         for _sweep in range(max_sweeps):
             improved = False
@@ -750,6 +769,9 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
                     o[np.ptp(rho[trial], axis=1) > cons.travel_mm] = np.inf
                 else:
                     o[np.max(np.abs(np.diff(rho[trial], axis=1)), axis=1) > cons.travel_mm] = np.inf
+                if close is not None:
+                    others = np.delete(idx, pos)
+                    o[np.any(close[np.ix_(free, others)], axis=1)] = np.inf
                 k = int(np.argmin(o))
                 if o[k] < cur - 1e-10 * max(abs(cur), 1.0):
                     idx, cur, improved = trial[k], o[k], True
@@ -931,7 +953,11 @@ def _random_start(robot, K, cons, rng, tries=50):
         if len(pts) < K:
             continue
         rho = pose_terms(robot, pts)["rho"]
-        idx = _feasible_random_subset(rng, rho, K, cons, tries=20)
+        close = None
+        if cons.min_separation_mm > 0:
+            close = np.linalg.norm(pts[:, None] - pts[None], axis=2) < cons.min_separation_mm
+            np.fill_diagonal(close, False)
+        idx = _feasible_random_subset(rng, rho, K, cons, tries=20, close=close)
         if idx is None:
             continue
         P = pts[idx]
@@ -1187,6 +1213,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         else:
             polished.append((label, P, _objective(robot, criterion, P, noise)))
     timing["order_polish"] = time.perf_counter() - t2
+    polished = [c for c in polished if not check_design(robot, c[1], cons)]
+    if not polished:
+        raise DesignError("neither method produced a design that meets the constraints")
     label, P, _ = min(polished, key=lambda c: c[2])
     timing["total"] = time.perf_counter() - t0
     return DesignResult(poses=P, criterion=criterion, report=evaluate(robot, P, criterion, noise, cons),
