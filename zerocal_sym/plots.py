@@ -33,7 +33,7 @@ def fig8_data(robot, ns=range(3, 22), maemm_prior=None) -> dict:
     return {"n": ns, "kappa_1": [a for a, _ in k], "kappa_m": [b for _, b in k], "maemm_prior_mm": list(prior)}
 
 
-def fig8(path, data: dict, paper_point=(3, 475.34, 472.54)) -> None:
+def fig8(path, data: dict, paper_point=(3, 475.34, 472.54), eps0=0.01) -> None:
     """Fig. 8: ``kappa_1`` and ``kappa_m`` vs n, written to ``path`` (PNG).
 
     Parameters
@@ -43,20 +43,29 @@ def fig8(path, data: dict, paper_point=(3, 475.34, 472.54)) -> None:
         From :func:`fig8_data`.
     paper_point : (n, kappa_1, kappa_m)
         The paper's values, marked.
+    eps0 : float
+        Threshold of the eps rule, drawn in the lower panel.
     """
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4), dpi=120)
-    ax.plot(data["n"], data["kappa_1"], "o-", label=r"$\kappa_1$ (1st identification)")
-    ax.plot(data["n"], data["kappa_m"], "s--",
-            label=r"$\kappa_m$ (MAEMM prior %s mm)" % (tuple(data["maemm_prior_mm"]),))
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(6, 6), dpi=120, sharex=True,
+                                  gridspec_kw={"height_ratios": [2, 1]})
+    n = np.asarray(data["n"])
+    k1, km = np.asarray(data["kappa_1"]), np.asarray(data["kappa_m"])
+    ax.plot(n, k1, "o-", label=r"$\kappa_1$ (1st identification)")
+    ax.plot(n, km, "s--", mfc="none", label=r"$\kappa_m$ (MAEMM prior %s mm)" % (tuple(data["maemm_prior_mm"]),))
     if paper_point:
-        n, k1, km = paper_point
-        ax.plot([n, n], [k1, km], "kx", ms=9, label=f"paper: n={n}, {k1}, {km}")
-    ax.set_xlabel("n (poses per boundary)")
+        p, pk1, pkm = paper_point
+        ax.plot([p, p], [pk1, pkm], "kx", ms=9, label=f"paper: n={p}, {pk1}, {pkm}")
     ax.set_ylabel("condition number of G")
     ax.set_title("Fig. 8: condition numbers vs n")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
+    ax2.plot(n, (k1 - km) / k1, "d-", color="C2", label=r"$\varepsilon = (\kappa_1 - \kappa_m)/\kappa_1$")
+    ax2.axhline(eps0, color="k", ls=":", lw=1, label=rf"$\varepsilon_0$ = {eps0:g}")
+    ax2.set_xlabel("n (poses per boundary)")
+    ax2.set_ylabel(r"$\varepsilon$")
+    ax2.grid(True, alpha=0.3)
+    ax2.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, format="png")
     plt.close(fig)
@@ -64,6 +73,8 @@ def fig8(path, data: dict, paper_point=(3, 475.34, 472.54)) -> None:
 
 def fig9(path, groups: list, mu0_deg=0.1) -> None:
     """Fig. 9: compensation values vs identification number, one panel per group.
+
+    Plotted as the deviation from the set value (both joints on one scale).
 
     Parameters
     ----------
@@ -79,26 +90,26 @@ def fig9(path, groups: list, mu0_deg=0.1) -> None:
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.2 * rows), dpi=110, squeeze=False)
     for ax, g in zip(axes.ravel(), groups):
         comp = np.asarray(g["history"]["compensation_deg"], float)
+        dev = comp - np.asarray(g["set_deg"], float)
         m = np.arange(1, comp.shape[0] + 1)
         for i, (mk, c) in enumerate((("o", "C0"), ("v", "C1"))):
-            ax.plot(m, comp[:, i], mk + "-", color=c, ms=4, label=rf"$\Delta\theta_{i + 1}$")
-            ax.axhline(g["set_deg"][i], color=c, ls=":", lw=1)
+            ax.plot(m, dev[:, i], mk + "-", color=c, ms=4,
+                    label=rf"$\Delta\theta_{i + 1}$ (set {g['set_deg'][i]:g}°)")
+        ax.axhline(0.0, color="k", lw=0.8)
         it = int(round(float(np.mean(g["iterations"]))))
         ax.axvline(it, color="grey", ls="--", lw=1)
         mu = [v for v in g["history"]["mu_deg"][it:] if v is not None]
-        after = comp[it - 1:] - np.asarray(g["set_deg"])
-        txt = f"after m={it}: max $\\delta$={np.max(np.abs(after)):.3f}°"
+        txt = f"after m={it}: max |δ|={np.max(np.abs(dev[it - 1:])):.3f}°"
         if mu:
-            txt += f", max $\\mu$={max(mu):.3f}°"
-        ax.set_title(f"group {g['group']}", fontsize=10)
-        ax.text(0.98, 0.5, txt, transform=ax.transAxes, ha="right", fontsize=7)
+            txt += f", max μ={max(mu):.3f}°"
+        ax.set_title(f"group {g['group']}\n{txt}", fontsize=9)
         ax.set_xlabel("identification m")
-        ax.set_ylabel("compensation [deg]")
+        ax.set_ylabel("compensation - set [deg]")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="best")
     for ax in axes.ravel()[k:]:
         ax.set_visible(False)
-    fig.suptitle(f"Fig. 9: compensation values vs m (dotted: set values; dashed: first mu < {mu0_deg:g} deg)",
+    fig.suptitle(f"Fig. 9: compensation value minus set value vs m (dashed: first mu < {mu0_deg:g} deg)",
                  fontsize=10)
     fig.tight_layout()
     fig.savefig(path, format="png")
