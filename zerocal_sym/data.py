@@ -228,6 +228,10 @@ def _read_text(path, what="file") -> tuple[str, str]:
         raw = raw[3:]
     elif raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise DataFileError("file is UTF-16 encoded: save it as UTF-8 (plain CSV)", where=f"{src}:1")
+    nul = raw.find(b"\x00")
+    if nul >= 0:
+        line = raw.count(b"\n", 0, nul) + 1
+        raise DataFileError("binary data (NUL byte) in a text file", where=f"{src}:{line}")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -236,11 +240,7 @@ def _read_text(path, what="file") -> tuple[str, str]:
         col = exc.start - (before.rfind(b"\n") + 1) + 1
         raise DataFileError(f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at column {col} "
                             "(save the file as UTF-8 CSV)", where=f"{src}:{line}") from None
-    text = text.replace("\r\n", "\n").replace("\r", "\n")
-    nul = text.find("\x00")
-    if nul >= 0:
-        raise DataFileError("binary data (NUL byte) in a text file", where=f"{src}:{text.count(chr(10), 0, nul) + 1}")
-    return text, src
+    return text.replace("\r\n", "\n").replace("\r", "\n"), src
 
 
 def _split_csv(text: str, src: str, format_prefix: str | None = None, version: int | None = None):
@@ -340,20 +340,18 @@ def _rows_to_records(rows, cols, src, int_cols=("pose",)):
 
 
 def _check_pose_numbers(values, lines, src, col_index):
+    """Poses numbered 0, 1, ... in file order; the first deviation is reported."""
     first = {}
     for k, rec in enumerate(values):
         p = int(rec["pose"])
-        if p in first:
-            raise DataFileError(f"column 'pose' (field {col_index}): pose {p} appears twice (lines {first[p]} and "
-                                f"{lines[k]}); poses are numbered 0, 1, ... in visiting order",
-                                where=f"{src}:{lines[k]}")
+        if p != k:
+            if p in first:
+                msg = f"pose {p} appears twice (lines {first[p]} and {lines[k]})"
+            else:
+                msg = f"expected {k}, got {p}" + (" (numbering starts at 0)" if k == 0 and p == 1 else "")
+            raise DataFileError(f"column 'pose' (field {col_index}): {msg}; poses are numbered 0, 1, ... in "
+                                "visiting order, one row each", where=f"{src}:{lines[k]}")
         first[p] = lines[k]
-    for k, rec in enumerate(values):
-        if rec["pose"] != k:
-            hint = " (numbering starts at 0)" if k == 0 and rec["pose"] == 1 else ""
-            raise DataFileError(f"column 'pose' (field {col_index}): expected {k}, got {int(rec['pose'])}{hint}; "
-                                "poses are numbered 0, 1, ... in visiting order, one row each",
-                                where=f"{src}:{lines[k]}")
 
 
 def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measurements:
