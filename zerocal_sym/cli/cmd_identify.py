@@ -41,6 +41,7 @@ def add_arguments(p):
                         "the MAEMM prior; repeatable")
     p.add_argument("--bound", action="append", default=[], metavar="NAME=LO:HI",
                    help="nlls bound of a parameter (deg for theta*, mm otherwise); repeatable")
+    p.add_argument("--max-iter", type=int, default=None, metavar="N", help="nlls: Ipopt iteration limit (default 200)")
     p.add_argument("--truncation", type=int, default=None, metavar="T", help="tsvd: fixed truncation level 1..4")
     p.add_argument("--rule", choices=["threshold", "gcv", "discrepancy"], default=None,
                    help="tsvd truncation rule (default: tsvd's default)")
@@ -132,18 +133,15 @@ def run(args):
     from zerocal_sym.measurement import NoiseModel
 
     robot = load_robot_arg(args)
-    meas = load_measurements(args.data, robot)
-    sha = meas.meta.get("robot_sha256")
-    if sha and sha != robot.sha256:
-        raise ZerocalError(f"the data were measured on robot {sha[:12]}..., not on this robot ({robot.sha256[:12]}...):"
-                           " pass the right --robot", where=args.data)
+    meas = load_measurements(args.data, robot)  # refuses data measured on another robot (robot_sha256)
     noise = NoiseModel.named(args.noise)
     prior = np.zeros(12)
     if args.maemm_prior is not None:
         prior[10:12] = args.maemm_prior
     if args.method == "tsvd":
-        if args.params != "paper" or args.prior_std or args.bound:
-            raise ZerocalError("--params, --prior-std and --bound are for --method nlls (tsvd identifies the paper's 4)")
+        if args.params != "paper" or args.prior_std or args.bound or args.max_iter is not None:
+            raise ZerocalError("--params, --prior-std, --bound and --max-iter are for --method nlls "
+                               "(tsvd identifies the paper's 4)")
         from zerocal_sym.tsvd import identify_tsvd
 
         kw = {}
@@ -172,8 +170,10 @@ def run(args):
             raise ZerocalError("--bound: LO must not exceed HI")
         from zerocal_sym.nlls import identify_nlls
 
+        if args.max_iter is not None and args.max_iter < 1:
+            raise ZerocalError("--max-iter must be >= 1")
         res = identify_nlls(robot, meas, names, noise=noise, prior=prior, bounds=bounds or None,
-                            prior_std=pstd or None)
+                            prior_std=pstd or None, max_iter=args.max_iter)
     report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=res.full_vector())
     out = result_json(robot, meas, res, report, args.data)
     if not res.success:
