@@ -39,6 +39,8 @@ def add_arguments(p):
                    help="comma-separated subset of tsvd-loop,tsvd,nlls,nlls-loop,nlls-seq,scipy")
     p.add_argument("--frame", choices=["paper", "literal"], default="paper",
                    help="how Table 2 is read (default paper, as 'zerocal reproduce')")
+    p.add_argument("--no-geometric", action="store_true",
+                   help="leave Table 2's geometric errors out of the plant (the 4-parameter model is then exact)")
     p.add_argument("--mu0", type=float, default=0.1, help="loop threshold of mu, deg (default 0.1)")
     p.add_argument("--max-iter", type=int, default=20, help="identifications per loop (default 20)")
     p.add_argument("--seed", type=int, default=0, help="seed (default 0)")
@@ -79,7 +81,8 @@ def run(args):
     bar = Progress(total, "compare", enabled=not args.quiet and total >= 5)
     rep = compare(robot, groups=groups, trials=args.trials, poses=poses, params=params,
                   noise=NoiseModel.named(args.noise), seed=args.seed, frame=args.frame, methods=methods,
-                  mu0_deg=args.mu0, max_iter=args.max_iter, progress=bar)
+                  mu0_deg=args.mu0, max_iter=args.max_iter, progress=bar,
+                  geometric=not args.no_geometric)
     rep["settings"]["robot_sha256"] = robot.sha256
     if args.out:
         write_json(args.out, rep)

@@ -179,6 +179,8 @@ def run(args):
     if not res.success:
         if args.json:
             print(to_json(out))
+        elif args.report:
+            print(format_report(report))
         print(f"zerocal identify: identification failed ({res.method}): {res.status}; no calibration written",
               file=sys.stderr)
         return 1
