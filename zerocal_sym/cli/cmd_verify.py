@@ -1,0 +1,142 @@
+"""Verify a compensation by re-identification (the paper's stopping rule).
+
+Measure again with the compensation applied (commands ``IK(P) - offset``:
+``zerocal compensate RESULT.json --scheme paper --template`` gives the sheet;
+``zerocal simulate --compensation D1 D2`` simulates it), then
+
+    zerocal verify RESULT.json ROUND2.csv [--out RESULT2.json]
+
+identifies the offsets again, linearised at the applied compensation and
+MAEMM estimate (paper Eq. 30), and compares: the remaining offset is
+``new - applied`` and the compensation accuracy
+``mu = sqrt(((new1 - applied1)^2 + (new2 - applied2)^2) / 2)``.  Exit status
+0 if ``mu < mu0`` (default 0.1 deg, the paper's), 1 if not: then apply the
+new result (``--out``, a results file like identify's) and verify again.
+
+Re-identification checks repeatability: a bias common to both rounds (e.g.
+from geometric errors outside the 4-parameter model) is not seen; an external
+position measurement (laser tracker) is the independent check.
+"""
+NAME = "verify"
+HELP = "re-identify with the compensation applied; pass if the remaining offset mu < mu0"
+
+
+def add_arguments(p):
+    p.add_argument("result", metavar="RESULT.json", help="the applied result (zerocal identify --json / verify --out)")
+    p.add_argument("data", metavar="DATA.csv", help="measurements taken with that compensation applied")
+    p.add_argument("--method", choices=["tsvd", "nlls"], default="tsvd", help="identification method (default tsvd)")
+    p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
+                   help="noise model for weights and covariance (default paper)")
+    p.add_argument("--mu0", type=float, default=0.1, help="threshold of the compensation accuracy mu, deg (0.1)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--out", metavar="FILE.json", default=None,
+                   help="write the new result (readable by compensate and verify), atomically")
+
+
+def _declared_compensation(meas):
+    """Compensation the data file says was applied (deg), or None."""
+    import re
+
+    import numpy as np
+
+    text = meas.meta.get("compensation_deg")
+    if text is None:
+        return None
+    vals = [v for v in re.split(r"[,\s]+", text.strip()) if v]
+    try:
+        out = np.array([float(v) for v in vals])
+    except ValueError:
+        return None
+    return out if out.shape == (2,) and np.all(np.isfinite(out)) else None
+
+
+def run(args):
+    import numpy as np
+
+    from zerocal_sym import data
+    from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.errors import DataFileError, ZerocalError
+    from zerocal_sym.io import to_json, write_json
+    from zerocal_sym.measurement import NoiseModel
+
+    if not (args.mu0 > 0 and np.isfinite(args.mu0)):
+        raise ZerocalError(f"--mu0 must be a positive number of degrees, got {args.mu0}")
+    robot = load_robot_arg(args)
+    applied = data.load_result(args.result)
+    if applied.robot_sha256 and applied.robot_sha256 != robot.sha256:
+        raise DataFileError(f"identified on another robot (robot_sha256 {applied.robot_sha256[:12]}..., "
+                            f"{robot.sha256[:12]}... for {robot.source}): pass the same --robot", where=args.result)
+    meas = data.load_measurements(args.data, robot)
+    declared = _declared_compensation(meas)
+    if declared is not None and np.max(np.abs(declared - applied.zero_offsets_deg)) > 1e-4:
+        line = meas.meta_lines.get("compensation_deg")
+        raise DataFileError(
+            f"the data were measured with compensation ({declared[0]:g}, {declared[1]:g}) deg, not with the "
+            f"result's offsets ({applied.zero_offsets_deg[0]:g}, {applied.zero_offsets_deg[1]:g}) deg",
+            where=f"{args.data}:{line}" if line else args.data)
+    noise = NoiseModel.named(args.noise)
+    prior = np.zeros(12)
+    prior[:2] = np.radians(applied.zero_offsets_deg)
+    if np.all(np.isfinite(applied.maemm_mm)):
+        prior[10:12] = applied.maemm_mm
+    if args.method == "tsvd":
+        from zerocal_sym.tsvd import identify_tsvd
+
+        res = identify_tsvd(robot, meas, prior=prior, noise=None if noise.is_zero else noise)
+    else:
+        from zerocal_sym.nlls import identify_nlls
+
+        res = identify_nlls(robot, meas, "paper", noise=noise, prior=prior)
+    if not res.success:
+        raise ZerocalError(f"re-identification failed ({res.method}): {res.status}", where=args.data)
+    new = res.zero_offsets_deg
+    remaining = new - applied.zero_offsets_deg
+    mu = float(np.sqrt(np.mean(remaining**2)))
+    std = res.std_zero_offsets_deg
+    passed = mu < args.mu0
+    report = {
+        "passed": bool(passed),
+        "mu_deg": mu,
+        "mu0_deg": args.mu0,
+        "applied_offsets_deg": applied.zero_offsets_deg.tolist(),
+        "new_offsets_deg": new.tolist(),
+        "remaining_offsets_deg": remaining.tolist(),
+        "std_new_offsets_deg": [float(s) if np.isfinite(s) else None for s in std],
+        "method": res.method,
+        "data": str(args.data),
+        "applied_result": str(args.result),
+    }
+    out = res.to_dict()
+    out.update(robot_sha256=robot.sha256, verification=report,
+               compensation={"sign_convention": data.SIGN_CONVENTION, "joints": ["theta1", "theta2"],
+                             "offset_deg": new.tolist(), "std_deg": report["std_new_offsets_deg"]})
+    if args.out:
+        write_json(args.out, _finite_or_none(out))
+    if args.json:
+        print(to_json(_finite_or_none(out)))
+    else:
+        print(f"{args.data}: re-identified ({res.method}) with the compensation of {args.result} applied")
+        print(f"  applied   offsets: {applied.zero_offsets_deg[0]:+.4f}, {applied.zero_offsets_deg[1]:+.4f} deg")
+        print(f"  new       offsets: {new[0]:+.4f}, {new[1]:+.4f} deg (std {std[0]:.3g}, {std[1]:.3g})")
+        print(f"  remaining offsets: {remaining[0]:+.4f}, {remaining[1]:+.4f} deg")
+        verdict = "PASS" if passed else "FAIL: apply the new result and measure again"
+        print(f"  mu = {mu:.4f} deg {'<' if passed else '>='} mu0 = {args.mu0:g} deg: {verdict}")
+        if args.out:
+            print(f"wrote {args.out}")
+    return 0 if passed else 1
+
+
+def _finite_or_none(obj):
+    import math
+
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return {k: _finite_or_none(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite_or_none(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _finite_or_none(obj.tolist())
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    return obj
