@@ -79,8 +79,7 @@ def test_symbolic_objective_matches_numeric(robot, cons, criterion):
 
 def test_psd_auxiliary_formulation_gives_eigenvalue_bounds(robot, cons):
     """E and cond: at Ipopt's solution the auxiliary bounds are the extreme eigenvalues."""
-    rng = np.random.default_rng(5)
-    P0 = design._random_start(robot, 6, cons, rng)
+    P0 = design.paper_baseline(robot, 6)
     fs, ms = design._scales(robot, P0, NOISE)
     for criterion in ("E", "cond"):
         nlp = design._NLP(robot, 6, criterion, cons, NOISE, fs, ms)
@@ -91,7 +90,9 @@ def test_psd_auxiliary_formulation_gives_eigenvalue_bounds(robot, cons):
         val = design.criterion_values(robot, P, NOISE)[criterion]
         f = float(sol["f"])
         got = np.exp(-f) * fs if criterion == "E" else np.exp(f)
-        assert got == pytest.approx(val, rel=1e-5)
+        # E uses the principal minors: at a double smallest eigenvalue the minor tolerance (1e-9)
+        # lets t exceed lambda_min by ~sqrt(tol); the design is always reported from the poses.
+        assert got == pytest.approx(val, rel=1e-3 if criterion == "E" else 1e-6)
 
 
 # ----------------------------------------------------------------- results that must be shown

@@ -57,17 +57,20 @@ are non-smooth where eigenvalues coalesce, so they use auxiliary variables
 and LMI-free eigenvalue constraints: ``max log t`` s.t. ``F_n - t I >= 0``,
 and ``min log(t_hi / t_lo) / 2`` s.t. ``M - t_lo I >= 0``, ``t_hi I - M >= 0``
 (``F_n``, ``M = G^T G`` normalised by their mean eigenvalue at a reference
-design; ``kappa = sqrt(t_hi / t_lo)`` at the optimum).  Each matrix
-inequality ``X >= 0`` is written ``X = L L^T`` with an auxiliary
-lower-triangular ``L`` (10 variables, ``diag(L) >= 0``, 10 polynomial
-equalities): exact, and linear in ``X`` so as well scaled as ``X``.
-(Measured alternatives, kept as ``psd_form="minors"``: the four *leading*
-principal minors admit spurious points where two minors vanish -- Ipopt
-stopped at ``t = lambda_2 > lambda_min`` -- and all 15 principal minors are
-exact but badly scaled: most ``cond`` starts hit the iteration limit.)
-For these two, Ipopt starts with a small barrier parameter
+design; ``kappa = sqrt(t_hi / t_lo)`` at the optimum).  A 4 x 4 matrix
+inequality ``X >= 0`` is written in one of two exact forms (``psd_form``):
+
+* ``"minors"``: all 15 principal minors >= 0 (used for ``E``);
+* ``"chol"``: ``X = L L^T`` with an auxiliary lower-triangular ``L``
+  (10 variables, ``diag(L) >= 0``, 10 polynomial equalities, linear in
+  ``X``; used for ``cond``, where the minors of ``M - t_lo I``, with
+  ``kappa^2 ~ 1e4``, are badly scaled and most starts hit the iteration limit).
+
+(Only the four *leading* minors would not do: they admit spurious points
+where two minors vanish -- Ipopt stopped at ``t = lambda_2 > lambda_min``.)
+For these two criteria Ipopt starts with a small barrier parameter
 (``mu_init = 1e-6``) so that the auxiliary variables are not pushed away
-from a good start.
+from a good start.  See docs/design.md for the measurements.
 
 Constraints
 -----------
@@ -118,6 +121,8 @@ MAX_K = 200
 #: the paper's scale range l0, mm
 SCALE_RANGE_MM = 350.0
 TRAVEL_MODES = ("range", "consecutive")
+#: formulation of the matrix inequalities per criterion (measured best, see module docstring)
+PSD_FORM = {"E": "minors", "cond": "chol"}
 #: paper parameter indices in the source-error vector
 _PAPER = (0, 1, 10, 11)
 _FEAS_TOL = 1e-6
@@ -803,10 +808,11 @@ class _NLP:
     """The symbolic design NLP for one (robot, K, criterion, constraints, noise)."""
 
     def __init__(self, robot, K, criterion, cons: Constraints, noise, fscale, mscale, max_iter=500,
-                 psd_form="chol", ipopt_options=None):
+                 psd_form=None, ipopt_options=None):
         import casadi as ca
 
         self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
+        psd_form = psd_form or PSD_FORM.get(criterion, "chol")
         sm2, sx2 = _noise_terms(noise)
         qs = _qscale(robot)
         c, h = cons.region.center, cons.region.half
