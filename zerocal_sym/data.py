@@ -298,7 +298,10 @@ def _check_header(header, header_line, src, allowed, required, example):
         for c in extra:
             close = difflib.get_close_matches(c.lower(), allowed, n=1, cutoff=0.6)
             hints.append(f"'{c}' (column {header.index(c) + 1}" + (f"; did you mean '{close[0]}'?)" if close else ")"))
-        raise DataFileError(f"unexpected column(s): {', '.join(hints)}; allowed: {', '.join(allowed)}", where=where)
+        missing = [c for c in required if c not in header]
+        miss = f"; missing: {', '.join(missing)}" if missing else ""
+        raise DataFileError(f"unexpected column(s): {', '.join(hints)}{miss}; allowed: {', '.join(allowed)}",
+                            where=where)
     missing = [c for c in required if c not in header]
     if missing:
         raise DataFileError(f"missing column(s): {', '.join(missing)} (header must be {example})", where=where)
