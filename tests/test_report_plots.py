@@ -125,6 +125,28 @@ def test_pngs_written_atomically(robot, tmp_path):
     assert sorted(p.name for p in (tmp_path / "sub").iterdir()) == sorted(outs)
 
 
+def test_command_level_plot_sets(robot, tmp_path):
+    from zerocal_sym import paper
+
+    meas = data.load_measurements(EXAMPLE, robot)
+    res = identify_tsvd(robot, meas)
+    d = rp.identify_plots(tmp_path / "id", res, meas, robot)
+    assert list(d) == ["residuals.png"] and (tmp_path / "id" / "residuals.png").read_bytes()[:8] == PNG
+    rep = paper.reproduce(robot, trials=1, groups=(1, 3), max_iter=4)
+    d = rp.reproduce_plots(tmp_path / "rep", rep, robot)
+    assert sorted(d) == ["convergence_group1.png", "convergence_group3.png", "fig12_group1.png", "fig12_group3.png"]
+    for name in d:
+        assert (tmp_path / "rep" / name).read_bytes()[:8] == PNG
+    g1 = rep["groups"][0]
+    # the plant's error before calibration at the 6 measurement poses is Table 4's 'before' (12.906 mm)
+    assert d["fig12_group1.png"]["max_before_mm"] >= g1["dpmax_before_mm"] - 1e-9
+    # compensation in Table 2's frame converted back to the robot's: the after-error matches reproduce's dp_max
+    six = rp.boundary_errors(robot, paper.group_errors(1), d["fig12_group1.png"]["compensation_deg"],
+                             P=paper_poses(robot, 3))
+    assert six["max_after_mm"] == pytest.approx(g1["dpmax_after_mm"], rel=1e-9)
+    np.testing.assert_allclose(d["convergence_group1.png"]["compensation_deg"], g1["history"]["compensation_deg"])
+
+
 def test_no_pyplot_no_backend_change():
     code = ("import sys, matplotlib; b = matplotlib.get_backend(); "
             "from zerocal_sym import report_plots as rp; from zerocal_sym.robot import paper_robot; "

@@ -88,11 +88,13 @@ def test_walkthrough(capsys, tmp_path, monkeypatch):
         zc(capsys, "compensate", result, *R, "--scheme", "paper", "--n", n, "--template", "--out", f"round{j}.csv")
         zc(capsys, "simulate", *R, "--group", 4, "--seed", j, "--noise", "scale-only", "--n", n,
            "--compensation", *off, "--out", f"round{j}.csv")
-        rc = main(["verify", result, f"round{j}.csv", *R, "--noise", "scale-only", "--out", f"result{j}.json"])
+        rc = main(["verify", result, f"round{j}.csv", *R, "--noise", "scale-only", "--out", f"result{j}.json",
+                   "--plot", f"plots{j}"])
         out, err = capsys.readouterr()
         assert rc in (0, 1), err
         assert ("PASS" in out) == (rc == 0)
         ver = json.loads(Path(f"result{j}.json").read_text())["verification"]
+        assert Path(f"plots{j}/residuals.png").read_bytes()[:4] == b"\x89PNG"
         assert ver["passed"] == (rc == 0) and ver["applied_offsets_deg"] == off
         if rc == 0:
             passed = True

@@ -312,6 +312,9 @@ def figure_convergence(d: dict, mu0_deg: float = 0.1, set_values_deg=None):
     ax2.semilogy(m[1:], d["mu_deg"][1:], "s-", ms=4, color="tab:red", label=r"$\mu$")
     ax2.axhline(mu0_deg, color="k", ls="--", lw=0.8, label=rf"$\mu_0$ = {mu0_deg:g} deg")
     ax2.set_xlabel("identification round m")
+    from matplotlib.ticker import MaxNLocator
+
+    ax2.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax2.set_ylabel(r"$\mu$ [deg]")
     ax2.legend(fontsize=8)
     return fig
@@ -322,3 +325,67 @@ def plot_convergence(history, path, set_values_deg=None, mu0_deg: float = 0.1) -
     d = convergence_data(history, set_values_deg)
     save_png(figure_convergence(d, mu0_deg, set_values_deg), path)
     return d
+
+
+# --------------------------------------------------------------------------- one call per command
+
+def identify_plots(out_dir, result, meas, robot) -> dict:
+    """The plots of one identification (``zerocal identify --plot DIR``).
+
+    Writes ``residuals.png`` in ``out_dir``.
+
+    Returns
+    -------
+    dict
+        file name -> the figure's data (:func:`residuals_data`).
+    """
+    from pathlib import Path
+
+    out_dir = Path(out_dir)
+    return {"residuals.png": plot_residuals(result, meas, out_dir / "residuals.png", robot)}
+
+
+def reproduce_plots(out_dir, rep: dict, robot=None, K: int = 42) -> dict:
+    """The per-group plots of a reproduction (``zerocal reproduce --plot DIR``).
+
+    For each group of ``rep`` (:func:`zerocal_sym.paper.reproduce`): the
+    position error over the K boundary positions before and after its
+    compensation value (Fig. 12 style, ``fig12_group{g}.png``) and the
+    convergence of the compensation values of its first trial
+    (``convergence_group{g}.png``).  Offsets are converted from Table 2's frame
+    (``rep["settings"]["frame"]``) to the robot's for the plant.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+    rep : dict
+        From :func:`zerocal_sym.paper.reproduce`.
+    robot : Robot, optional
+        Default: the paper's.
+    K : int
+        Number of boundary positions.
+
+    Returns
+    -------
+    dict
+        file name -> the figure's data.
+    """
+    from pathlib import Path
+
+    from zerocal_sym.paper import group_errors, to_table_frame
+    from zerocal_sym.robot import paper_robot
+
+    robot = robot or paper_robot()
+    out_dir = Path(out_dir)
+    frame = rep["settings"]["frame"]
+    out = {}
+    for g in rep["groups"]:
+        n = int(g["group"])
+        comp = to_table_frame(np.asarray(g["compensation_deg"], float), frame, "offsets")  # an involution
+        name = f"fig12_group{n}.png"
+        out[name] = plot_boundary_errors(robot, group_errors(n, frame), comp, out_dir / name, K=K,
+                                         title=f"Group {n}: position error over the boundary (Fig. 12 style)")
+        name = f"convergence_group{n}.png"
+        out[name] = plot_convergence(g["history"], out_dir / name, set_values_deg=g["set_deg"],
+                                     mu0_deg=rep["settings"].get("mu0_deg", 0.1))
+    return out

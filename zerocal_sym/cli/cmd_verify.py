@@ -31,6 +31,8 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", metavar="FILE.json", default=None,
                    help="write the new result (readable by compensate and verify), atomically")
+    p.add_argument("--plot", metavar="DIR", default=None,
+                   help="write residuals.png (residuals per pose of the re-identification) into DIR")
 
 
 def _declared_compensation(meas):
@@ -110,6 +112,10 @@ def run(args):
     out.update(robot_sha256=robot.sha256, verification=report,
                compensation={"sign_convention": data.SIGN_CONVENTION, "joints": ["theta1", "theta2"],
                              "offset_deg": new.tolist(), "std_deg": report["std_new_offsets_deg"]})
+    if args.plot:
+        from zerocal_sym.report_plots import identify_plots
+
+        identify_plots(args.plot, res, meas, robot)
     if args.out:
         write_json(args.out, _finite_or_none(out))
     if args.json:
