@@ -248,3 +248,31 @@ def test_console_script_exit_status(tmp_path):
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
     assert f"{p}:{row(2)[0]}: column 'theta1_deg' (field 2): nan is not a finite number" in r.stderr
+
+
+# --------------------------------------------------------------------------- verify and unwritable outputs
+
+def test_verify_bad_data(capsys, tmp_path):
+    p = data_file(tmp_path, edit(2, 1, "inf")[0])
+    check_error(capsys, tmp_path, ["verify", str(_result(tmp_path)), str(p)], r"inf is not a finite number",
+                where=f"{p}:{row(2)[0]}", command="verify")
+
+
+def test_verify_bad_result(capsys, tmp_path):
+    p = data_file(tmp_path, EXAMPLE)
+    check_error(capsys, tmp_path, ["verify", str(_result(tmp_path, success=False)), str(p)],
+                r"the identification failed", command="verify")
+
+
+def test_verify_bad_mu0(capsys, tmp_path):
+    p = data_file(tmp_path, EXAMPLE)
+    check_error(capsys, tmp_path, ["verify", str(_result(tmp_path)), str(p), "--mu0", "-1"],
+                r"--mu0 must be a positive number", command="verify")
+
+
+@pytest.mark.parametrize("command", ["compensate", "verify"])
+def test_output_is_a_directory(capsys, tmp_path, command):
+    argv = (["compensate", str(_result(tmp_path))] if command == "compensate"
+            else ["verify", str(_result(tmp_path)), str(data_file(tmp_path, EXAMPLE))])
+    rc, out, err = run_cli(capsys, argv + ["--out", str(tmp_path)])
+    assert rc == 2 and err.count("\n") == 1 and "cannot write the output" in err and str(tmp_path) in err, err

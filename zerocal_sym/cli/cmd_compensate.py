@@ -90,7 +90,10 @@ def run(args):
         else:
             text, what = data.format_commands(P, nominal, cmd, offsets, meta), "compensated commands"
     if args.out:
-        atomic_write_text(args.out, text)
+        try:
+            atomic_write_text(args.out, text)
+        except OSError as exc:
+            raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=args.out) from None
     if args.json:
         print(to_json({"zero_offsets_deg": [float(v) for v in offsets], "sign_convention": data.SIGN_CONVENTION,
                        "output": args.out, "kind": what, "poses": K}))

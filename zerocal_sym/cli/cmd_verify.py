@@ -112,12 +112,17 @@ def run(args):
     out.update(robot_sha256=robot.sha256, verification=report,
                compensation={"sign_convention": data.SIGN_CONVENTION, "joints": ["theta1", "theta2"],
                              "offset_deg": new.tolist(), "std_deg": report["std_new_offsets_deg"]})
-    if args.plot:
-        from zerocal_sym.report_plots import identify_plots
+    target = args.plot
+    try:
+        if args.plot:
+            from zerocal_sym.report_plots import identify_plots
 
-        identify_plots(args.plot, res, meas, robot)
-    if args.out:
-        write_json(args.out, _finite_or_none(out))
+            identify_plots(args.plot, res, meas, robot)
+        target = args.out
+        if args.out:
+            write_json(args.out, _finite_or_none(out))
+    except OSError as exc:
+        raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=target) from None
     if args.json:
         print(to_json(_finite_or_none(out)))
     else:
