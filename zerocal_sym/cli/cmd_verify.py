@@ -63,6 +63,12 @@ def run(args):
 
     if not (args.mu0 > 0 and np.isfinite(args.mu0)):
         raise ZerocalError(f"--mu0 must be a positive number of degrees, got {args.mu0}")
+    from pathlib import Path
+
+    for opt, path in (("--out", args.out), ("--plot", args.plot)):
+        if path and Path(path).exists() and (Path(path).is_dir() if opt == "--out" else not Path(path).is_dir()):
+            raise ZerocalError(f"{opt} {path}: {'is a directory' if opt == '--out' else 'is not a directory'}",
+                               where=path)
     robot = load_robot_arg(args)
     applied = data.load_result(args.result)
     if applied.robot_sha256 and applied.robot_sha256 != robot.sha256:
