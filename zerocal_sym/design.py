@@ -117,7 +117,8 @@ CRITERIA = {
     "crlb": ("RMS Cramer-Rao bound of the two zero offsets (full noise model)", "deg", "min"),
 }
 MIN_K = 5
-MAX_K = 200
+#: largest K accepted (design time grows roughly as K^2: ~15 s at K = 40 with 3 starts)
+MAX_K = 100
 #: the paper's scale range l0, mm
 SCALE_RANGE_MM = 350.0
 TRAVEL_MODES = ("range", "consecutive")

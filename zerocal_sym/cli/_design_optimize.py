@@ -80,7 +80,7 @@ def _print_text(out, res):
     print(f"constraints: region x in [{c['region_mm'][0]:g}, {c['region_mm'][1]:g}], y in [{c['region_mm'][2]:g}, "
           f"{c['region_mm'][3]:g}] mm; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "
-          f"{'none' if jl is None else jl} deg; poses >= {c['min_separation_mm']:g} mm apart")
+          f"{'none' if jl is None else str(jl) + ' deg'}; poses >= {c['min_separation_mm']:g} mm apart")
     n = out["noise"]
     print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, servo {n['sigma_servo_deg']:.4g} deg "
           "per joint per pose")
