@@ -275,4 +275,5 @@ def test_output_is_a_directory(capsys, tmp_path, command):
     argv = (["compensate", str(_result(tmp_path))] if command == "compensate"
             else ["verify", str(_result(tmp_path)), str(data_file(tmp_path, EXAMPLE))])
     rc, out, err = run_cli(capsys, argv + ["--out", str(tmp_path)])
-    assert rc == 2 and err.count("\n") == 1 and "cannot write the output" in err and str(tmp_path) in err, err
+    assert rc == 2 and err.count("\n") == 1 and str(tmp_path) in err, err
+    assert "cannot write the output" in err or "is a directory" in err, err
