@@ -62,6 +62,8 @@ IPOPT_OPTIONS = {
     "ipopt.max_iter": 200,
     "print_time": False,
 }
+#: Ipopt return statuses that count as converged (anything else: success False)
+CONVERGED_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 #: relative threshold on singular values of the scaled, whitened Jacobian
 RANK_RTOL = 1e-9
 
@@ -310,7 +312,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         stats = solver.stats()
         total_iter += int(stats.get("iter_count", 0))
         zn = sol["x"].full().ravel()
-        if not stats.get("success", False):
+        if str(stats.get("return_status")) not in CONVERGED_STATUSES:
             z = zn
             break
         moved = np.max(np.abs(zn - z)) if rnd else np.inf
@@ -318,7 +320,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         if rnd and moved < 1e-9:
             break
     ret = str(stats.get("return_status", "unknown"))
-    converged = bool(stats.get("success", False)) and np.all(np.isfinite(z))
+    converged = ret in CONVERGED_STATUSES and bool(np.all(np.isfinite(z)))
     p_hat = z / scale
     W = _weights(robot, theta_cmd, noise, full(p_hat))
     par = prob.pack(theta_cmd, robot.geometry, prior12, s, W, scale, mu, w)
