@@ -96,7 +96,7 @@ class _Problem:
         keep = np.ones(f.size1_in(2))
         keep[list(idx)] = 0.0
         p = z / sc
-        err = keep * efix + ca.mtimes(ca.DM(E), p)
+        err = ca.DM(keep) * efix + ca.mtimes(ca.DM(E), p)
         rho = f.map(K)(th, g, err)            # 1 x K
         pred = (rho[0, 1:] - rho[0, :-1]).T   # m x 1
         r = ca.mtimes(W, s - pred)
