@@ -59,6 +59,10 @@ def main(argv=None) -> int:
     except ZerocalError as exc:
         print(f"zerocal {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # an unwritable --out, a directory given for a file, a full disk
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"zerocal {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f"zerocal {args.command}: interrupted", file=sys.stderr)
         return 130

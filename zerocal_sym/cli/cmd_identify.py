@@ -48,6 +48,8 @@ def add_arguments(p):
     p.add_argument("--report", action="store_true", help="also print the identifiability report (text output)")
     p.add_argument("--json", action="store_true", help="print the results JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, help="write the results JSON here")
+    p.add_argument("--plot", metavar="DIR", default=None,
+                   help="write residuals.png (measured minus predicted change per pose) into DIR")
 
 
 def _unit(name):
@@ -184,6 +186,10 @@ def run(args):
         print(f"zerocal identify: identification failed ({res.method}): {res.status}; no calibration written",
               file=sys.stderr)
         return 1
+    if args.plot:
+        from zerocal_sym.report_plots import identify_plots
+
+        identify_plots(args.plot, res, meas, robot)
     if args.out:
         write_json(args.out, out)
     if args.json:

@@ -31,7 +31,10 @@ def add_arguments(p):
                    help="fixed TSVD truncation level 1..4 (default: the --rule)")
     p.add_argument("--rule", choices=["threshold", "gcv", "discrepancy"], default="threshold",
                    help="automatic TSVD truncation rule (default threshold: keeps all 4)")
-    p.add_argument("--out", metavar="DIR", default=None, help="write fig8.png, fig9.png, results.json here")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="write fig8.png, fig9.png, results.json and, per group, fig12_group{g}.png "
+                        "(position error on the 42 boundary positions before/after) and "
+                        "convergence_group{g}.png here")
     p.add_argument("--json", action="store_true", help="print the results as JSON")
 
 
@@ -59,6 +62,7 @@ def _write_out(out_dir, rep, robot, n):
 
     from zerocal_sym.io import write_json
     from zerocal_sym.plots import fig8, fig8_data, fig9
+    from zerocal_sym.report_plots import reproduce_plots
 
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
@@ -71,16 +75,18 @@ def _write_out(out_dir, rep, robot, n):
         d8 = fig8_data(robot, range(3, 22))
         fig8(tmp / "fig8.png", d8)
         fig9(tmp / "fig9.png", rep["groups"], rep["settings"]["mu0_deg"])
+        reproduce_plots(tmp, rep, robot)
         write_json(tmp / "results.json", dict(rep, fig8=d8))
+        names = sorted(p.name for p in tmp.iterdir())
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o777 & ~umask)
-        for name in ("fig8.png", "fig9.png", "results.json"):
+        for name in names:
             os.chmod(tmp / name, 0o666 & ~umask)
         if not out.exists():
             os.rename(tmp, out)
         else:
-            for name in ("fig8.png", "fig9.png", "results.json"):
+            for name in names:
                 os.replace(tmp / name, out / name)
             tmp.rmdir()
     except BaseException:
@@ -126,5 +132,6 @@ def run(args):
     else:
         print(format_tables(rep))
         if args.out:
-            print(f"wrote fig8.png, fig9.png, results.json to {args.out}")
+            print(f"wrote fig8.png, fig9.png, fig12_group*.png, convergence_group*.png, results.json "
+                  f"to {args.out}")
     return 0
