@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from zerocal_sym import design, fisher, kinematics as kin, scheme
 from zerocal_sym.cli import main
-from zerocal_sym.design import DesignError, Region
+from zerocal_sym.design import DesignError
 from zerocal_sym.measurement import NoiseModel
 
 NOISE = NoiseModel.paper()

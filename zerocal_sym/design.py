@@ -106,6 +106,7 @@ import numpy as np
 
 from zerocal_sym import kinematics as kin
 from zerocal_sym.errors import PoseError, ZerocalError
+from zerocal_sym.io import json_safe
 from zerocal_sym.measurement import NoiseModel
 
 #: criterion name -> (description, units, better: "min" | "max")
@@ -1110,7 +1111,7 @@ class DesignResult:
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
-        return _clean(self._dict())
+        return json_safe(self._dict())
 
     def _dict(self) -> dict:
         rep = dict(self.report)
@@ -1134,20 +1135,6 @@ class DesignResult:
         })
         return rep
 
-
-def _clean(o):
-    """Replace non-finite floats by None, recursively (JSON has no inf/nan)."""
-    if isinstance(o, dict):
-        return {k: _clean(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_clean(v) for v in o]
-    if isinstance(o, np.ndarray):
-        return _clean(o.tolist())
-    if isinstance(o, (float, np.floating)):
-        return float(o) if math.isfinite(o) else None
-    if isinstance(o, np.integer):
-        return int(o)
-    return o
 
 
 def _ratio(a, b):

@@ -50,6 +50,27 @@ def _default(o):
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
+def json_safe(obj):
+    """``obj`` with non-finite floats replaced by None and numpy types by Python ones, recursively.
+
+    JSON has no inf/NaN: an unbounded standard deviation (a parameter that is
+    not identifiable) is written as ``null``.
+    """
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return json_safe(obj.tolist())
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if np.isfinite(obj) else None
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
 def to_json(obj, indent=2) -> str:
     """JSON text of ``obj`` (numpy arrays and scalars allowed)."""
     return json.dumps(obj, indent=indent, default=_default, allow_nan=False)

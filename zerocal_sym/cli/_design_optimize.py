@@ -90,7 +90,7 @@ def _print_text(out, res):
           f"Ipopt multi-start, {ok}/{len(co['runs'])} feasible ends: {_fmt(co['value'])}; "
           f"total {out['timing_s']['total']:.2f} s)")
     P, Pp = np.array(out["poses"]), np.array(out["paper"]["poses"])
-    J, Jp = np.array(out["joints_deg"]), np.array(out["paper"]["joints_deg"])
+    J = np.array(out["joints_deg"])
     print()
     print(f"{'k':>3} {'x [mm]':>9} {'y [mm]':>9} {'th1 [deg]':>10} {'th2 [deg]':>10}   |"
           f" {'paper x':>8} {'paper y':>8}")

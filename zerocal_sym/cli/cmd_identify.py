@@ -76,26 +76,6 @@ def _parse_named(items, names, what, parse):
     return out
 
 
-def _finite_or_none(obj):
-    """Replace non-finite floats (JSON has no inf/NaN) by None, recursively."""
-    import math
-
-    import numpy as np
-
-    if isinstance(obj, dict):
-        return {k: _finite_or_none(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite_or_none(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _finite_or_none(obj.tolist())
-    if isinstance(obj, (float, np.floating)):
-        return float(obj) if math.isfinite(obj) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
-
 
 def result_json(robot, meas, res, report, source) -> dict:
     """The results JSON: IdentificationResult.to_dict plus robot, data, compensation, identifiability."""
@@ -118,7 +98,9 @@ def result_json(robot, meas, res, report, source) -> dict:
         "std_deg": [float(s) if np.isfinite(s) else None for s in std],
     }
     d["identifiability"] = report
-    return _finite_or_none(d)
+    from zerocal_sym.io import json_safe
+
+    return json_safe(d)
 
 
 def run(args):

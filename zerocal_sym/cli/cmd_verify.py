@@ -58,7 +58,7 @@ def run(args):
     from zerocal_sym import data
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import DataFileError, ZerocalError
-    from zerocal_sym.io import to_json, write_json
+    from zerocal_sym.io import json_safe, to_json, write_json
     from zerocal_sym.measurement import NoiseModel
 
     if not (args.mu0 > 0 and np.isfinite(args.mu0)):
@@ -126,11 +126,11 @@ def run(args):
             identify_plots(args.plot, res, meas, robot)
         target = args.out
         if args.out:
-            write_json(args.out, _finite_or_none(out))
+            write_json(args.out, json_safe(out))
     except OSError as exc:
         raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=target) from None
     if args.json:
-        print(to_json(_finite_or_none(out)))
+        print(to_json(json_safe(out)))
     else:
         print(f"{args.data}: re-identified ({res.method}) with the compensation of {args.result} applied")
         print(f"  applied   offsets: {applied.zero_offsets_deg[0]:+.4f}, {applied.zero_offsets_deg[1]:+.4f} deg")
@@ -141,19 +141,3 @@ def run(args):
         if args.out:
             print(f"wrote {args.out}")
     return 0 if passed else 1
-
-
-def _finite_or_none(obj):
-    import math
-
-    import numpy as np
-
-    if isinstance(obj, dict):
-        return {k: _finite_or_none(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite_or_none(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _finite_or_none(obj.tolist())
-    if isinstance(obj, (float, np.floating)):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
