@@ -1,6 +1,7 @@
 """docs/walkthrough.md end to end on a simulated robot, and the
 simulate -> identify round trip (set values recovered within the noise)."""
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -126,12 +127,18 @@ def test_verify_rejects_data_measured_with_another_compensation(capsys, tmp_path
 
 # --------------------------------------------------------------------------- the round trip through the shell
 
-@pytest.mark.skipif(shutil.which("zerocal") is None, reason="console script not installed")
 def test_simulate_identify_round_trip_shell(tmp_path):
-    """``zerocal simulate ... --out d.csv && zerocal identify d.csv --json``: the set values come back."""
+    """``zerocal simulate ... --out d.csv && zerocal identify d.csv --json``: the set values come back.
+
+    Runs the installed console script (the one beside this interpreter, so it
+    works without an activated venv, as in CI).
+    """
+    bindir = str(Path(sys.executable).parent)
+    env = dict(os.environ, PATH=bindir + os.pathsep + os.environ.get("PATH", ""))
+    assert shutil.which("zerocal", path=env["PATH"]), f"console script `zerocal` not installed in {bindir}"
     cmd = ("zerocal simulate --group 4 --seed 3 --noise scale-only --out d.csv && "
            "zerocal identify d.csv --noise scale-only --json")
-    r = subprocess.run(cmd, shell=True, cwd=tmp_path, capture_output=True, text=True)
+    r = subprocess.run(cmd, shell=True, cwd=tmp_path, capture_output=True, text=True, env=env)
     assert r.returncode == 0, r.stderr
     res = json.loads(r.stdout[r.stdout.index("{"):])
     truth = true_offsets(tmp_path / "d.csv")
