@@ -1,5 +1,6 @@
 """The measurement format at the API level: round trip, the example file, and
 every kind of bad input (message names file, line and column)."""
+import importlib.util
 import json
 import re
 import subprocess
@@ -116,11 +117,10 @@ def test_example_file_is_valid_and_reproducible(robot, tmp_path):
     m = data.load_measurements(EXAMPLE, robot=robot)
     assert m.K == 6 and m.meta["robot_sha256"] == robot.sha256
     np.testing.assert_allclose(m.target, scheme.paper_poses(robot, 3))
-    sys.path.insert(0, str(ROOT / "examples"))
-    try:
-        import make_measurements_example as mk
-    finally:
-        sys.path.pop(0)
+    spec = importlib.util.spec_from_file_location("make_measurements_example",
+                                                  ROOT / "examples" / "make_measurements_example.py")
+    mk = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mk)
     assert data.format_measurements(mk.make_example()) == EXAMPLE.read_text()
 
 
