@@ -80,3 +80,8 @@ def test_cli_robot_json(capsys):
     assert s["home_pose_mm"] == pytest.approx([0, 688.186], abs=5e-4)
     assert set(s["corners"]) == {"(-b/2, H)", "(b/2, H)", "(-b/2, H+h)", "(b/2, H+h)"}
     assert s["min_transmission_sine"] > s["singularity_margin"]
+
+
+def test_table_instead_of_key_names_its_line(tmp_path):
+    with pytest.raises(RobotFileError, match=r"r\.toml:12: unknown key 'extra'"):
+        load_robot(write(tmp_path, base_text() + "[extra]\nx = 1\n"))

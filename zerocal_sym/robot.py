@@ -139,7 +139,7 @@ def paper_robot() -> Robot:
 
 def _line_of(text: str, key: str):
     for i, line in enumerate(text.splitlines(), 1):
-        if re.match(rf"\s*{re.escape(key)}\s*=", line):
+        if re.match(rf"\s*({re.escape(key)}\s*=|\[\s*{re.escape(key)}\s*\])", line):
             return i
     return None
 
