@@ -4,19 +4,11 @@ Target (issue 2): `zerocal --help` answers in under a second.
 Usage: python benchmarks/bench_cli.py [--repeat N]
 """
 import argparse
-import statistics
-import subprocess
 import sys
-import time
+
+from _harness import wall
 
 
-def wall(cmd, repeat):
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True)
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), min(times)
 
 
 def main():

@@ -13,11 +13,11 @@ Usage: python benchmarks/bench_paper.py [--repeat N]
 """
 import argparse
 import statistics
-import subprocess
 import sys
 import time
 
 import numpy as np
+from _harness import wall
 
 
 def per_call(fn, n):
@@ -28,13 +28,6 @@ def per_call(fn, n):
     return (time.perf_counter() - t) / n
 
 
-def wall(cmd, repeat):
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True)
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def main():
@@ -74,8 +67,8 @@ def main():
     n_id = sum(len(g["history"]["kappa"]) for g in rep["groups"])
     print(f"\nreproduce in process: {t_rep:.3f} s median of {a.repeat} ({n_id} identifications, "
           f"{t_rep / n_id * 1e3:.2f} ms each = {t_rep / n_id / t_ident:.2f} x identify_tsvd)")
-    base = wall([sys.executable, "-c", "pass"], a.repeat)
-    cli = wall([sys.executable, "-m", "zerocal_sym", "reproduce"], a.repeat)
+    base = wall([sys.executable, "-c", "pass"], a.repeat)[0]
+    cli = wall([sys.executable, "-m", "zerocal_sym", "reproduce"], a.repeat)[0]
     print(f"`zerocal reproduce` (subprocess): {cli:.3f} s median; python -c pass: {base:.3f} s; "
           f"ratio {cli / base:.1f}")
     print(f"target: zerocal reproduce well under a minute: {'met' if cli < 60 else 'NOT met'} ({cli:.2f} s)")
