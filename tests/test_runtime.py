@@ -31,3 +31,11 @@ def test_help_path_does_not_import_casadi():
             "assert not heavy, heavy")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_source_error_names_match_the_generated_mechanism(robot):
+    """The numeric layers' parameter order is the derivation's (one source of truth)."""
+    from zerocal_sym.measurement import SOURCE_ERROR_NAMES
+
+    assert tuple(robot.mechanism.source_error_names) == SOURCE_ERROR_NAMES
+    assert robot.mechanism.geometry_names[:8] == ["e1x", "e1y", "e2x", "e2y", "L1", "L2", "l1", "l2"]
