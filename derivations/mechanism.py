@@ -83,7 +83,10 @@ def implicit_pose_jacobian(mech: SymbolicMechanism, wrt):
     f = sp.Matrix(mech.loop_closure)
     fP = f.jacobian(sp.Matrix(mech.pose))
     fq = f.jacobian(sp.Matrix(wrt))
-    return -fP.LUsolve(fq)
+    # adjugate / determinant: the only division is by det(df/dP), which vanishes
+    # exactly at the parallel singularities. (LU pivoting would divide by a
+    # pivot entry too and put a spurious singularity where that entry is zero.)
+    return -(fP.adjugate() * fq) / fP.det()
 
 
 def measuring_vector(mech: SymbolicMechanism):

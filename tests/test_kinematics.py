@@ -143,3 +143,21 @@ def test_check_poses_singularity_margin(robot):
         kin.check_poses(robot, P, margin=0.99)
     with pytest.raises(PoseError, match="outside the workspace"):
         kin.check_poses(robot, np.array([[0.0, 600.0]]), in_workspace=True)
+
+
+def test_error_jacobian_has_no_spurious_singularity(robot):
+    """At P straight above B1 (w1 = (0, 1)) the Jacobian is regular; only det W may vanish.
+
+    (An LU-pivoted implicit differentiation divides by w1x and gives inf here.)
+    """
+    P = np.array([[robot.param("e1x") + robot.param("L1"), robot.param("e1y") + robot.param("l1")]])
+    th = kin.ik(robot, P)[0]
+    assert th[0] == pytest.approx(0.0, abs=1e-12)
+    J = kin.pose_error_jacobian(robot, P)[0]
+    assert np.all(np.isfinite(J))
+    for j in range(10):
+        h = 1e-6 if j < 2 else 1e-4
+        e = np.zeros(12)
+        e[j] = h
+        fd = (_perturbed_pose(robot, th, e) - _perturbed_pose(robot, th, -e)) / (2 * h)
+        assert J[:, j] == pytest.approx(fd, rel=1e-5, abs=1e-6), SOURCE_ERROR_NAMES[j]

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/planar_2dof.py
-inputs hash: d7b3cdff5887eb71
+inputs hash: 0c9aacba7b1a46f8
 sympy: 1.14.0
 """
 import casadi as ca
@@ -93,35 +93,37 @@ def _pose_error_jacobian(P, theta, g):
     l1 = g[6]
     l2 = g[7]
     t0 = ca.sin(theta1)
-    t1 = ca.cos(theta1)
-    t2 = e1x*t0 - e1y*t1 - t0*x + t1*y
-    t3 = -y
-    t4 = L1*t0 + e1y + t3
-    t5 = -x
-    t6 = ca.cos(theta2)
-    t7 = L2*t6 + e2x + t5
-    t8 = L1*t1 + e1x + t5
-    t9 = ca.sin(theta2)
-    t10 = L2*t9 + e2y + t3
-    t11 = 1/t8
-    t12 = t11*t4
-    t13 = t12*t7
-    t14 = t13/(t10 - t4*t7/t8)
-    t15 = L1*t11
-    t16 = 1/(t10 - t13)
-    t17 = L2*t16*(e2x*t9 - e2y*t6 + t6*y - t9*x)
-    t18 = t16*t7
-    t19 = t11*t18
-    t20 = t12*t18
-    t21 = -t20
-    t22 = t10*t16
-    t23 = L1*t0**2 + L1*t1**2 + e1x*t1 + e1y*t0 - t0*y - t1*x
-    t24 = t16*(L2*t6**2 + L2*t9**2 + e2x*t6 + e2y*t9 - t6*x - t9*y)
-    t25 = l1*t11
-    t26 = l2*t16
+    t1 = L1*t0
+    t2 = ca.cos(theta1)
+    t3 = t2*y
+    t4 = ca.cos(theta2)
+    t5 = L2*t4
+    t6 = ca.sin(theta2)
+    t7 = L2*t6
+    t8 = L1*t2
+    t9 = t0*x
+    t10 = t4*y
+    t11 = 1/(L1*t3 - L1*t9 - L2*t10 - e1x*e2y - e1x*t7 + e1x*y + e1y*e2x + e1y*t5 - e1y*x + e2x*t1 - e2x*y - e2y*t8 + e2y*x + t1*t5 - t7*t8 + t7*x)
+    t12 = -y
+    t13 = t11*(e2y + t12 + t7)
+    t14 = L1*(e1x*t0 - e1y*t2 + t3 - t9)
+    t15 = e1y + t1 + t12
+    t16 = t11*t15
+    t17 = L2*(e2x*t6 - e2y*t4 + t10 - t6*x)
+    t18 = -x
+    t19 = e1x + t18 + t8
+    t20 = -t13*t19
+    t21 = t13*t15
+    t22 = e2x + t18 + t5
+    t23 = t16*t22
+    t24 = L1*t0**2 + L1*t2**2 + e1x*t2 + e1y*t0 - t0*y - t2*x
+    t25 = L2*t4**2 + L2*t6**2 + e2x*t4 + e2y*t6 - t4*x - t6*y
+    t26 = t11*t22
+    t27 = t11*t19
+    t28 = t19*t26
     J_src = ca.vertcat(
-        ca.horzcat(-t15*(t14*t2 + t2), t12*t17, t11*(t18*t4 + t8), t11*(t19*t4**2 + t4), t21, -t12*t22, t11*(t20*t23 + t23), -t12*t24, -t25*(t14 + 1), t12*t26),
-        ca.horzcat(t15*t18*t2, -t17, -t18, t21, t18, t22, -t19*t23, t24, t18*t25, -t26),
+        ca.horzcat(t13*t14, -t16*t17, t20, -t21, t23, t21, -t13*t24, t16*t25, l1*t13, -l2*t16),
+        ca.horzcat(-t14*t26, t17*t27, t28, t23, -t28, t20, t24*t26, -t25*t27, -l1*t26, l2*t27),
     )
     return (J_src,)
 
@@ -140,35 +142,38 @@ def _error_jacobian_full(P, theta, g):
     L2 = g[5]
     l1 = g[6]
     l2 = g[7]
-    t0 = -x
+    t0 = ca.sin(theta1)
     t1 = ca.cos(theta1)
-    t2 = L1*t1 + e1x + t0
-    t3 = 1/t2
-    t4 = ca.sin(theta1)
-    t5 = e1x*t4 - e1y*t1 + t1*y - t4*x
-    t6 = -y
-    t7 = L1*t4 + e1y + t6
-    t8 = ca.cos(theta2)
-    t9 = L2*t8 + e2x + t0
-    t10 = ca.sin(theta2)
-    t11 = L2*t10 + e2y + t6
-    t12 = t3*t7
-    t13 = t12*t9
-    t14 = t13/(t11 - t7*t9/t2)
-    t15 = 1/(t11 - t13)
-    t16 = t15*t9
-    t17 = t16*t3
-    t18 = L1*t1**2 + L1*t4**2 + e1x*t1 + e1y*t4 - t1*x - t4*y
-    t19 = t12*t16
-    t20 = l1*t3
-    t21 = t15*(e2x*t10 - e2y*t8 - t10*x + t8*y)
-    t22 = -t19
-    t23 = t11*t15
-    t24 = t15*(L2*t10**2 + L2*t8**2 + e2x*t8 + e2y*t10 - t10*y - t8*x)
-    t25 = l2*t15
+    t2 = t1*y
+    t3 = t0*x
+    t4 = e1x*t0 - e1y*t1 + t2 - t3
+    t5 = L1*t0
+    t6 = ca.cos(theta2)
+    t7 = L2*t6
+    t8 = ca.sin(theta2)
+    t9 = L2*t8
+    t10 = L1*t1
+    t11 = t6*y
+    t12 = 1/(L1*t2 - L1*t3 - L2*t11 - e1x*e2y - e1x*t9 + e1x*y + e1y*e2x + e1y*t7 - e1y*x + e2x*t5 - e2x*y - e2y*t10 + e2y*x - t10*t9 + t5*t7 + t9*x)
+    t13 = -y
+    t14 = t12*(e2y + t13 + t9)
+    t15 = -x
+    t16 = e1x + t10 + t15
+    t17 = -t14*t16
+    t18 = e1y + t13 + t5
+    t19 = t14*t18
+    t20 = L1*t0**2 + L1*t1**2 + e1x*t1 + e1y*t0 - t0*y - t1*x
+    t21 = e2x*t8 - e2y*t6 + t11 - t8*x
+    t22 = t12*t18
+    t23 = e2x + t15 + t7
+    t24 = t22*t23
+    t25 = L2*t6**2 + L2*t8**2 + e2x*t6 + e2y*t8 - t6*x - t8*y
+    t26 = t12*t23
+    t27 = t16*t26
+    t28 = t12*t16
     J_full = ca.vertcat(
-        ca.horzcat(-t3*(t14*t5 + t5), t3*(t16*t7 + t2), t3*(t17*t7**2 + t7), t3*(t18*t19 + t18), -t20*(t14 + 1), t12*t21, t22, -t12*t23, -t12*t24, t12*t25),
-        ca.horzcat(t17*t5, -t16, t22, -t17*t18, t16*t20, -t21, t16, t23, t24, -t25),
+        ca.horzcat(t14*t4, t17, -t19, -t14*t20, l1*t14, -t21*t22, t24, t19, t22*t25, -l2*t22),
+        ca.horzcat(-t26*t4, t27, t24, t20*t26, -l1*t26, t21*t28, -t27, t17, -t25*t28, l2*t28),
     )
     return (J_full,)
 
@@ -185,25 +190,25 @@ def _error_jacobian(P, theta, g):
     e2y = g[3]
     L1 = g[4]
     L2 = g[5]
-    t0 = -x
-    t1 = ca.cos(theta1)
-    t2 = L1*t1 + e1x + t0
-    t3 = 1/t2
-    t4 = ca.sin(theta1)
-    t5 = e1x*t4 - e1y*t1 + t1*y - t4*x
-    t6 = -y
-    t7 = L1*t4 + e1y + t6
-    t8 = ca.cos(theta2)
-    t9 = L2*t8 + e2x + t0
-    t10 = ca.sin(theta2)
-    t11 = L2*t10 + e2y + t6
-    t12 = t3*t7
-    t13 = t12*t9
-    t14 = 1/(t11 - t13)
-    t15 = t14*(e2x*t10 - e2y*t8 - t10*x + t8*y)
+    t0 = -y
+    t1 = ca.sin(theta2)
+    t2 = L2*t1
+    t3 = ca.sin(theta1)
+    t4 = L1*t3
+    t5 = ca.cos(theta1)
+    t6 = t5*y
+    t7 = ca.cos(theta2)
+    t8 = L2*t7
+    t9 = L1*t5
+    t10 = t3*x
+    t11 = t7*y
+    t12 = 1/(-L1*t10 + L1*t6 - L2*t11 - e1x*e2y - e1x*t2 + e1x*y + e1y*e2x + e1y*t8 - e1y*x + e2x*t4 - e2x*y - e2y*t9 + e2y*x - t2*t9 + t2*x + t4*t8)
+    t13 = t12*(e1x*t3 - e1y*t5 - t10 + t6)
+    t14 = t12*(e2x*t1 - e2y*t7 - t1*x + t11)
+    t15 = -x
     J = ca.vertcat(
-        ca.horzcat(-t3*(t13*t5/(t11 - t7*t9/t2) + t5), t12*t15),
-        ca.horzcat(t14*t3*t5*t9, -t15),
+        ca.horzcat(t13*(e2y + t0 + t2), -t14*(e1y + t0 + t4)),
+        ca.horzcat(-t13*(e2x + t15 + t8), t14*(e1x + t15 + t9)),
     )
     return (J,)
 
@@ -242,24 +247,23 @@ def _g_row(P, theta, g):
     dx = g[10]
     dy = g[11]
     t0 = -x
-    t1 = ca.cos(theta1)
-    t2 = L1*t1 + e1x + t0
-    t3 = 1/t2
-    t4 = cx + dx + t0
-    t5 = -y
-    t6 = cy + dy + t5
-    t7 = 1/ca.sqrt(t4**2 + t6**2)
-    t8 = ca.sin(theta2)
-    t9 = ca.sin(theta1)
-    t10 = L1*t9 + e1y + t5
-    t11 = ca.cos(theta2)
-    t12 = L2*t11 + e2x + t0
-    t13 = 1/(L2*t8 + e2y - t10*t12/t2 + t5)
-    t14 = e1x*t9 - e1y*t1 + t1*y - t9*x
-    t15 = t12*t13*t14
-    t16 = t10*t3
+    t1 = cx + dx + t0
+    t2 = -y
+    t3 = ca.sin(theta2)
+    t4 = L2*t3
+    t5 = cy + dy + t2
+    t6 = ca.cos(theta2)
+    t7 = L2*t6
+    t8 = ca.sin(theta1)
+    t9 = ca.cos(theta1)
+    t10 = t9*y
+    t11 = t8*x
+    t12 = 1/ca.sqrt(t1**2 + t5**2)
+    t13 = L1*t8
+    t14 = L1*t9
+    t15 = t12/(L1*t10 - L1*t11 - e1x*e2y - e1x*t4 + e1x*y + e1y*e2x + e1y*t7 - e1y*x + e2x*t13 - e2x*y - e2y*t14 + e2y*x + t13*t7 - t14*t4 + t4*x - t7*y)
     row = ca.vertcat(
-        ca.horzcat(-t3*t7*(t15*t6 + t4*(-t14 - t15*t16)), t13*t7*(-t16*t4 + t6)*(e2x*t8 - e2y*t11 + t11*y - t8*x), t4*t7, t6*t7),
+        ca.horzcat(t15*(-t1*(e2y + t2 + t4) + t5*(e2x + t0 + t7))*(e1x*t8 - e1y*t9 + t10 - t11), t15*(t1*(e1y + t13 + t2) - t5*(e1x + t0 + t14))*(e2x*t3 - e2y*t6 - t3*x + t6*y), t1*t12, t12*t5),
     )
     return (row,)
 
