@@ -191,15 +191,14 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
         ``after_mm`` (K,), ``max_before_mm``, ``max_after_mm`` (float),
         ``compensation_deg`` (2,).
     """
-    from zerocal_sym import kinematics as kin
     from zerocal_sym.measurement import VirtualPlant
+    from zerocal_sym.paper import position_errors
 
     P = boundary_positions(robot, K) if P is None else np.atleast_2d(np.asarray(P, float))
     comp = np.radians(np.asarray(compensation_deg, float))
     plant = VirtualPlant(robot, err_true)
-    nominal = kin.ik(robot, P)
-    before = np.linalg.norm(plant.actual_pose(nominal) - P, axis=1)
-    after = np.linalg.norm(plant.actual_pose(nominal - comp) - P, axis=1)
+    before = position_errors(robot, plant, P)
+    after = position_errors(robot, plant, P, comp)
     return {
         "index": np.arange(1, len(P) + 1),
         "P": P,
