@@ -19,7 +19,7 @@ def main():
     rows = [
         ("python -c pass (baseline)", [sys.executable, "-c", "pass"]),
         ("zerocal --help", [sys.executable, "-m", "zerocal_sym", "--help"]),
-        ("import zerocal_sym.kinematics (casadi)", [sys.executable, "-c", "import zerocal_sym.kinematics"]),
+        ("import zerocal_sym.model.kinematics (casadi)", [sys.executable, "-c", "import zerocal_sym.model.kinematics"]),
         ("zerocal robot", [sys.executable, "-m", "zerocal_sym", "robot"]),
     ]
     print(f"{'command':42s} {'median [s]':>10s} {'min [s]':>8s} {'x baseline':>10s}")

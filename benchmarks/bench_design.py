@@ -14,9 +14,9 @@ import time
 
 
 
-from zerocal_sym import design
-from zerocal_sym.measurement import NoiseModel
-from zerocal_sym.robot import paper_robot
+from zerocal_sym.design import optimize as design
+from zerocal_sym.model.noise import NoiseModel
+from zerocal_sym.model.robot import paper_robot
 
 
 def timed(fn, repeat):

@@ -44,13 +44,13 @@ def main():
 
     from scipy.optimize import least_squares
 
-    from zerocal_sym import kinematics as kin
-    from zerocal_sym.data import Measurements
-    from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
-    from zerocal_sym.nlls import get_problem, identify_nlls, residual_problem
-    from zerocal_sym.report_plots import boundary_positions
-    from zerocal_sym.robot import paper_robot
-    from zerocal_sym.scheme import paper_poses
+    from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.io.measurements import Measurements
+    from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+    from zerocal_sym.identify.nlls import get_problem, identify_nlls, residual_problem
+    from zerocal_sym.report.plots import boundary_positions
+    from zerocal_sym.model.robot import paper_robot
+    from zerocal_sym.paper.scheme import paper_poses
 
     robot = paper_robot()
     noise = NoiseModel.paper()
@@ -64,8 +64,8 @@ def main():
         prob = get_problem(robot, K, "paper")
 
         # the raw solver call, with the parameter vector identify_nlls builds
-        from zerocal_sym import fisher
-        from zerocal_sym.nlls import _weights
+        from zerocal_sym.identify import fisher
+        from zerocal_sym.identify.nlls import _weights
 
         scale = fisher.parameter_scale(robot, "paper")
         pars = []

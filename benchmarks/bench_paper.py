@@ -35,12 +35,12 @@ def main():
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args()
 
-    from zerocal_sym import kinematics as kin
-    from zerocal_sym.measurement import NoiseModel, VirtualPlant
-    from zerocal_sym.paper import group_errors, reproduce, simulate_round
-    from zerocal_sym.robot import paper_robot
-    from zerocal_sym.scheme import identification_matrix, paper_poses
-    from zerocal_sym.tsvd import identify_tsvd, tsvd_solve
+    from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+    from zerocal_sym.paper.reproduction import group_errors, reproduce, simulate_round
+    from zerocal_sym.model.robot import paper_robot
+    from zerocal_sym.paper.scheme import identification_matrix, paper_poses
+    from zerocal_sym.identify.tsvd import identify_tsvd, tsvd_solve
 
     robot = paper_robot()
     P = paper_poses(robot, 3)

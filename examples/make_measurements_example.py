@@ -19,11 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
-from zerocal_sym import data, kinematics, scheme
-from zerocal_sym.io import atomic_write_text
-from zerocal_sym.measurement import NoiseModel, VirtualPlant
-from zerocal_sym.paper import group_errors
-from zerocal_sym.robot import paper_robot
+from zerocal_sym.io import measurements as data
+from zerocal_sym.model import kinematics
+from zerocal_sym.paper import scheme
+from zerocal_sym.io.files import atomic_write_text
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+from zerocal_sym.paper.reproduction import group_errors
+from zerocal_sym.model.robot import paper_robot
 
 HERE = Path(__file__).resolve().parent
 SEED = 2017

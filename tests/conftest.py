@@ -12,7 +12,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 @pytest.fixture(scope="session")
 def robot():
-    from zerocal_sym.robot import paper_robot
+    from zerocal_sym.model.robot import paper_robot
 
     return paper_robot()
 

@@ -4,11 +4,11 @@ import json
 import numpy as np
 import pytest
 
-from zerocal_sym import kinematics as kin
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.cli import main
-from zerocal_sym.data import Measurements, load_result, write_measurements
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
-from zerocal_sym.scheme import paper_poses
+from zerocal_sym.io.measurements import Measurements, load_result, write_measurements
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.paper.scheme import paper_poses
 
 
 @pytest.fixture

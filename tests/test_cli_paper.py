@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from zerocal_sym.cli import main
-from zerocal_sym.data import load_measurements
-from zerocal_sym.tsvd import identify_tsvd
+from zerocal_sym.io.measurements import load_measurements
+from zerocal_sym.identify.tsvd import identify_tsvd
 
 
 def run(capsys, *argv):

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from zerocal_sym.cli import main
-from zerocal_sym.compare import METHODS, Progress, compare, format_compare, scipy_identify
-from zerocal_sym.data import Measurements
-from zerocal_sym import kinematics as kin
+from zerocal_sym.identify.compare import METHODS, Progress, compare, format_compare, scipy_identify
+from zerocal_sym.io.measurements import Measurements
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
-from zerocal_sym.nlls import identify_nlls
-from zerocal_sym.scheme import paper_poses
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.identify.nlls import identify_nlls
+from zerocal_sym.paper.scheme import paper_poses
 
 
 def test_compare_all_methods_small(robot):

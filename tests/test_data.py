@@ -10,9 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from zerocal_sym import data, kinematics, scheme
+from zerocal_sym.io import measurements as data
+from zerocal_sym.model import kinematics
+from zerocal_sym.paper import scheme
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "measurements_example.csv"
@@ -22,7 +24,7 @@ HL = 3  # header line of the files written by format_measurements(good_meas)
 
 @pytest.fixture(scope="module")
 def good_meas():
-    from zerocal_sym.robot import paper_robot
+    from zerocal_sym.model.robot import paper_robot
 
     robot = paper_robot()
     P = scheme.paper_poses(robot, 3)
@@ -313,7 +315,7 @@ def test_unassemblable_pose(tmp_path, good_text):
     """A robot whose distal links cannot always close: the angles are no assembly (first bad pose named)."""
     from dataclasses import replace
 
-    from zerocal_sym.robot import paper_robot
+    from zerocal_sym.model.robot import paper_robot
 
     r = paper_robot()
     short = replace(r, geometry=r.geometry * np.array([1, 1, 1, 1, 1, 1, 0.35, 0.35, 1, 1, 1, 1]))
@@ -466,5 +468,5 @@ def test_compensation_table_states_the_sign(tmp_path):
 
 
 def test_runtime_module_has_no_heavy_imports():
-    code = "import sys, zerocal_sym.data; assert 'matplotlib' not in sys.modules and 'sympy' not in sys.modules"
+    code = "import sys, zerocal_sym.io.measurements; assert 'matplotlib' not in sys.modules and 'sympy' not in sys.modules"
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0

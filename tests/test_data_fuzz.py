@@ -6,9 +6,9 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from zerocal_sym import data
+from zerocal_sym.io import measurements as data
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.robot import paper_robot
+from zerocal_sym.model.robot import paper_robot
 
 ROOT = Path(__file__).resolve().parents[1]
 VALID = (ROOT / "examples" / "measurements_example.csv").read_text()

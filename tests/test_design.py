@@ -6,10 +6,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from zerocal_sym import design, fisher, kinematics as kin, scheme
+from zerocal_sym.design import optimize as design
+from zerocal_sym.identify import fisher
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.paper import scheme
 from zerocal_sym.cli import main
-from zerocal_sym.design import DesignError
-from zerocal_sym.measurement import NoiseModel
+from zerocal_sym.design.optimize import DesignError
+from zerocal_sym.model.noise import NoiseModel
 
 NOISE = NoiseModel.paper()
 

@@ -2,11 +2,12 @@
 import numpy as np
 import pytest
 
-from zerocal_sym import fisher, kinematics as kin
-from zerocal_sym.data import Measurements
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
-from zerocal_sym.nlls import identify_nlls
-from zerocal_sym.scheme import paper_poses
+from zerocal_sym.identify import fisher
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.io.measurements import Measurements
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.identify.nlls import identify_nlls
+from zerocal_sym.paper.scheme import paper_poses
 
 
 @pytest.fixture(scope="module")

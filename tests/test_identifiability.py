@@ -3,9 +3,11 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from zerocal_sym import fisher, identifiability as idf, kinematics as kin
-from zerocal_sym.measurement import NoiseModel, table2_errors
-from zerocal_sym.scheme import paper_poses
+from zerocal_sym.identify import fisher
+from zerocal_sym.identify import identifiability as idf
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model.noise import NoiseModel, table2_errors
+from zerocal_sym.paper.scheme import paper_poses
 
 
 @pytest.fixture(scope="module")

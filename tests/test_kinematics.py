@@ -5,9 +5,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import twin
-from zerocal_sym import kinematics as kin
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError
-from zerocal_sym.measurement import SOURCE_ERROR_NAMES, VirtualPlant
+from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, VirtualPlant
 
 xs = st.floats(-240, 240)
 ys = st.floats(632, 782)

@@ -1,12 +1,14 @@
-"""Ipopt identification on the exact model (zerocal_sym.nlls)."""
+"""Ipopt identification on the exact model (zerocal_sym.identify.nlls)."""
 import numpy as np
 import pytest
 
-from zerocal_sym import fisher, identifiability as idf, kinematics as kin
-from zerocal_sym.data import Measurements
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
-from zerocal_sym.nlls import get_problem, identify_nlls, make_nlls_identifier, residual_problem
-from zerocal_sym.scheme import paper_poses
+from zerocal_sym.identify import fisher
+from zerocal_sym.identify import identifiability as idf
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.io.measurements import Measurements
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.identify.nlls import get_problem, identify_nlls, make_nlls_identifier, residual_problem
+from zerocal_sym.paper.scheme import paper_poses
 
 PAPER4 = [0, 1, 10, 11]
 

@@ -6,11 +6,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from zerocal_sym import data, kinematics, report_plots as rp
-from zerocal_sym.measurement import NoiseModel, VirtualPlant
-from zerocal_sym.paper import calibration_loop, group_errors
-from zerocal_sym.scheme import paper_poses
-from zerocal_sym.tsvd import identify_tsvd
+from zerocal_sym.io import measurements as data
+from zerocal_sym.model import kinematics
+from zerocal_sym.report import plots as rp
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+from zerocal_sym.paper.reproduction import calibration_loop, group_errors
+from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.identify.tsvd import identify_tsvd
 
 PNG = b"\x89PNG\r\n\x1a\n"
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "measurements_example.csv"
@@ -126,7 +128,7 @@ def test_pngs_written_atomically(robot, tmp_path):
 
 
 def test_command_level_plot_sets(robot, tmp_path):
-    from zerocal_sym import paper
+    from zerocal_sym.paper import reproduction as paper
 
     meas = data.load_measurements(EXAMPLE, robot)
     res = identify_tsvd(robot, meas)
@@ -149,7 +151,7 @@ def test_command_level_plot_sets(robot, tmp_path):
 
 def test_no_pyplot_no_backend_change():
     code = ("import sys, matplotlib; b = matplotlib.get_backend(); "
-            "from zerocal_sym import report_plots as rp; from zerocal_sym.robot import paper_robot; "
+            "from zerocal_sym.report import plots as rp; from zerocal_sym.model.robot import paper_robot; "
             "import numpy as np; f = rp.figure_boundary_errors(rp.boundary_errors(paper_robot(), np.zeros(12), [0, 0]));"
             "assert 'matplotlib.pyplot' not in sys.modules; assert matplotlib.get_backend() == b")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -157,6 +159,6 @@ def test_no_pyplot_no_backend_change():
 
 
 def test_import_is_light():
-    r = subprocess.run([sys.executable, "-c", "import sys, zerocal_sym.report_plots; "
+    r = subprocess.run([sys.executable, "-c", "import sys, zerocal_sym.report.plots; "
                         "assert 'matplotlib' not in sys.modules"], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr

@@ -9,7 +9,7 @@ import pytest
 
 from zerocal_sym.cli import main
 from zerocal_sym.errors import RobotFileError
-from zerocal_sym.robot import load_robot, paper_robot
+from zerocal_sym.model.robot import load_robot, paper_robot
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "paper_robot.toml"
 

@@ -4,8 +4,8 @@ import sys
 
 
 def test_import_does_not_pull_sympy():
-    code = ("import sys, zerocal_sym, zerocal_sym.kinematics, zerocal_sym.fisher, zerocal_sym.data; "
-            "from zerocal_sym.robot import paper_robot; paper_robot().home_pose(); "
+    code = ("import sys, zerocal_sym, zerocal_sym.model.kinematics, zerocal_sym.identify.fisher, zerocal_sym.io.measurements; "
+            "from zerocal_sym.model.robot import paper_robot; paper_robot().home_pose(); "
             "assert 'sympy' not in sys.modules, 'sympy imported'")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
@@ -35,7 +35,7 @@ def test_help_path_does_not_import_casadi():
 
 def test_source_error_names_match_the_generated_mechanism(robot):
     """The numeric layers' parameter order is the derivation's (one source of truth)."""
-    from zerocal_sym.measurement import SOURCE_ERROR_NAMES
+    from zerocal_sym.model.noise import SOURCE_ERROR_NAMES
 
     assert tuple(robot.mechanism.source_error_names) == SOURCE_ERROR_NAMES
     assert robot.mechanism.geometry_names[:8] == ["e1x", "e1y", "e2x", "e2y", "L1", "L2", "l1", "l2"]

@@ -2,14 +2,14 @@
 import numpy as np
 import pytest
 
-from zerocal_sym import kinematics as kin
-from zerocal_sym.data import Measurements
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.io.measurements import Measurements
 from zerocal_sym.errors import IdentificationError
-from zerocal_sym.fisher import crlb_zero_offsets_deg
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, source_errors
-from zerocal_sym.paper import simulate_round
-from zerocal_sym.scheme import paper_poses
-from zerocal_sym.tsvd import identify_tsvd, tsvd_solve
+from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, source_errors
+from zerocal_sym.paper.reproduction import simulate_round
+from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.identify.tsvd import identify_tsvd, tsvd_solve
 
 
 def _designed(sv, m=7, seed=0):

@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from zerocal_sym import data, kinematics, report_plots
+from zerocal_sym.io import measurements as data
+from zerocal_sym.model import kinematics
+from zerocal_sym.report import plots as report_plots
 from zerocal_sym.cli import main
 from zerocal_sym.errors import DataFileError
 
@@ -35,7 +37,7 @@ def test_walkthrough(capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     shutil.copy(MY_ROBOT, "my_robot.toml")
     R = ("--robot", "my_robot.toml")
-    from zerocal_sym.robot import load_robot
+    from zerocal_sym.model.robot import load_robot
 
     robot = load_robot("my_robot.toml")
 
@@ -108,7 +110,7 @@ def test_walkthrough(capsys, tmp_path, monkeypatch):
     final = np.array(json.loads(Path(result).read_text())["zero_offsets_deg"])
     assert np.max(np.abs(final - truth)) < 0.25, (final, truth)
     # and it reduces the position error over the boundary (what a laser tracker would confirm)
-    from zerocal_sym.paper import group_errors
+    from zerocal_sym.paper.reproduction import group_errors
 
     b = report_plots.boundary_errors(robot, group_errors(4), final)
     assert b["max_after_mm"] < 0.2 * b["max_before_mm"]

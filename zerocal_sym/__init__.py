@@ -2,9 +2,9 @@
 
 Layers (imports go one way): ``derivations/`` (sympy, not imported at run
 time) -> :mod:`zerocal_sym.generated` (committed CasADi builders) ->
-:mod:`~zerocal_sym.mechanisms`, :mod:`~zerocal_sym.robot`,
-:mod:`~zerocal_sym.kinematics`, :mod:`~zerocal_sym.measurement`,
-:mod:`~zerocal_sym.fisher` (models) -> identification and design -> CLI and
+:mod:`~zerocal_sym.model.mechanism`, :mod:`~zerocal_sym.model.robot`,
+:mod:`~zerocal_sym.model.kinematics`, :mod:`~zerocal_sym.model.noise`,
+:mod:`~zerocal_sym.identify.fisher` (models) -> identification and design -> CLI and
 notebooks.
 
 Units: mm and radians inside; degrees at the user-facing edges.

@@ -43,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def load_robot_arg(args):
     """The robot named by ``--robot`` (or the paper's)."""
-    from zerocal_sym.robot import load_robot, paper_robot
+    from zerocal_sym.model.robot import load_robot, paper_robot
 
     return load_robot(args.robot) if args.robot else paper_robot()
 

@@ -24,10 +24,10 @@ def _fmt(v, spec=".4g"):
 def run(args):
     import numpy as np
 
-    from zerocal_sym import design
+    from zerocal_sym.design import optimize as design
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.io import to_json
-    from zerocal_sym.measurement import NoiseModel
+    from zerocal_sym.io.files import to_json
+    from zerocal_sym.model.noise import NoiseModel
 
     robot = load_robot_arg(args)
     K = args.K
@@ -57,7 +57,7 @@ def run(args):
         out["verify"] = {"design": vd, "paper": vp,
                          "rms_ratio_design_over_paper": design._ratio(vd["rms_error_rms_deg"],
                                                                       vp["rms_error_rms_deg"]),
-                         "estimator": "zerocal_sym.nlls.identify_nlls (Ipopt, exact model, paper's 4 parameters)"}
+                         "estimator": "zerocal_sym.identify.nlls.identify_nlls (Ipopt, exact model, paper's 4 parameters)"}
         out["paper"]["verify"] = vp
     if args.plot:
         design.plot_design(args.plot, robot, res)
@@ -138,6 +138,6 @@ def _print_text(out, res):
 
 
 def _desc(name):
-    from zerocal_sym.design import CRITERIA
+    from zerocal_sym.design.optimize import CRITERIA
 
     return CRITERIA[name][0]

@@ -15,15 +15,15 @@ from __future__ import annotations
 def run(args):
     import numpy as np
 
-    from zerocal_sym import kinematics as kin
+    from zerocal_sym.model import kinematics as kin
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import PoseError, ZerocalError
-    from zerocal_sym.fisher import crlb_zero_offsets_deg
-    from zerocal_sym.io import to_json
-    from zerocal_sym.measurement import NoiseModel
-    from zerocal_sym.paper import (DEFAULT_MAEMM_PRIOR, MAEMM_PRIOR_READINGS, PAPER_KAPPA_1, PAPER_KAPPA_M,
+    from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
+    from zerocal_sym.io.files import to_json
+    from zerocal_sym.model.noise import NoiseModel
+    from zerocal_sym.paper.reproduction import (DEFAULT_MAEMM_PRIOR, MAEMM_PRIOR_READINGS, PAPER_KAPPA_1, PAPER_KAPPA_M,
                                    kappas, select_n)
-    from zerocal_sym.scheme import identification_matrix, paper_poses
+    from zerocal_sym.paper.scheme import identification_matrix, paper_poses
 
     robot = load_robot_arg(args)
     prior = tuple(float(v) for v in args.maemm_prior) if args.maemm_prior else DEFAULT_MAEMM_PRIOR

@@ -51,10 +51,10 @@ def add_arguments(p):
 
 def run(args):
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.compare import Progress, compare, format_compare
+    from zerocal_sym.identify.compare import Progress, compare, format_compare
     from zerocal_sym.errors import ZerocalError
-    from zerocal_sym.io import to_json, write_json
-    from zerocal_sym.measurement import NoiseModel
+    from zerocal_sym.io.files import to_json, write_json
+    from zerocal_sym.model.noise import NoiseModel
 
     robot = load_robot_arg(args)
     if args.trials < 1:
@@ -63,16 +63,16 @@ def run(args):
     if any(g not in range(1, 7) for g in groups):
         raise ZerocalError(f"--group must be 1..6, got {args.group}")
     if args.poses == "paper":
-        from zerocal_sym.scheme import paper_poses
+        from zerocal_sym.paper.scheme import paper_poses
 
         poses = paper_poses(robot, args.n)
     else:
-        from zerocal_sym.data import load_poses
+        from zerocal_sym.io.measurements import load_poses
 
         poses = load_poses(args.poses, robot)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     try:
-        from zerocal_sym.fisher import param_names
+        from zerocal_sym.identify.fisher import param_names
 
         params = param_names(args.params)
     except ValueError as exc:

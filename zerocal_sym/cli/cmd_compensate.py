@@ -43,10 +43,10 @@ def add_arguments(p):
 def run(args):
     import numpy as np
 
-    from zerocal_sym import data
+    from zerocal_sym.io import measurements as data
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import DataFileError, ZerocalError
-    from zerocal_sym.io import atomic_write_text, to_json
+    from zerocal_sym.io.files import atomic_write_text, to_json
 
     robot = load_robot_arg(args)
     has_poses = args.poses is not None or args.scheme is not None
@@ -79,7 +79,7 @@ def run(args):
         if args.poses is not None:
             P = data.load_poses(args.poses, robot)
         else:
-            from zerocal_sym.scheme import paper_poses
+            from zerocal_sym.paper.scheme import paper_poses
 
             P = paper_poses(robot, args.n)
         nominal, cmd = data.compensated_commands(robot, P, offsets)

@@ -81,7 +81,7 @@ def result_json(robot, meas, res, report, source) -> dict:
     """The results JSON: IdentificationResult.to_dict plus robot, data, compensation, identifiability."""
     import numpy as np
 
-    from zerocal_sym.data import SIGN_CONVENTION
+    from zerocal_sym.io.measurements import SIGN_CONVENTION
 
     d = res.to_dict()
     keep = ("solver_status", "iterations", "cost", "chi2", "dof", "time_s", "weighting", "warm_start", "rank",
@@ -98,7 +98,7 @@ def result_json(robot, meas, res, report, source) -> dict:
         "std_deg": [float(s) if np.isfinite(s) else None for s in std],
     }
     d["identifiability"] = report
-    from zerocal_sym.io import json_safe
+    from zerocal_sym.io.files import json_safe
 
     return json_safe(d)
 
@@ -108,13 +108,13 @@ def run(args):
 
     import numpy as np
 
-    from zerocal_sym import fisher
+    from zerocal_sym.identify import fisher
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.data import load_measurements
+    from zerocal_sym.io.measurements import load_measurements
     from zerocal_sym.errors import ZerocalError
-    from zerocal_sym.identifiability import format_report, identifiability_report
-    from zerocal_sym.io import to_json, write_json
-    from zerocal_sym.measurement import NoiseModel
+    from zerocal_sym.identify.identifiability import format_report, identifiability_report
+    from zerocal_sym.io.files import to_json, write_json
+    from zerocal_sym.model.noise import NoiseModel
 
     robot = load_robot_arg(args)
     meas = load_measurements(args.data, robot)  # refuses data measured on another robot (robot_sha256)
@@ -126,7 +126,7 @@ def run(args):
         if args.params != "paper" or args.prior_std or args.bound or args.max_iter is not None:
             raise ZerocalError("--params, --prior-std, --bound and --max-iter are for --method nlls "
                                "(tsvd identifies the paper's 4)")
-        from zerocal_sym.tsvd import identify_tsvd
+        from zerocal_sym.identify.tsvd import identify_tsvd
 
         kw = {}
         if args.rule is not None:
@@ -152,7 +152,7 @@ def run(args):
                               (_ for _ in ()).throw(ValueError(v)))
         if any(lo > hi for lo, hi in bounds.values()):
             raise ZerocalError("--bound: LO must not exceed HI")
-        from zerocal_sym.nlls import identify_nlls
+        from zerocal_sym.identify.nlls import identify_nlls
 
         if args.max_iter is not None and args.max_iter < 1:
             raise ZerocalError("--max-iter must be >= 1")
@@ -169,7 +169,7 @@ def run(args):
               file=sys.stderr)
         return 1
     if args.plot:
-        from zerocal_sym.report_plots import identify_plots
+        from zerocal_sym.report.plots import identify_plots
 
         identify_plots(args.plot, res, meas, robot)
     if args.out:

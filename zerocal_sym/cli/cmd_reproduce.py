@@ -60,9 +60,9 @@ def _write_out(out_dir, rep, robot, n):
     import tempfile
     from pathlib import Path
 
-    from zerocal_sym.io import write_json
-    from zerocal_sym.plots import fig8, fig8_data, fig9
-    from zerocal_sym.report_plots import reproduce_plots
+    from zerocal_sym.io.files import write_json
+    from zerocal_sym.paper.figures import fig8, fig8_data, fig9
+    from zerocal_sym.report.plots import reproduce_plots
 
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
@@ -99,10 +99,10 @@ def run(args):
 
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import ZerocalError
-    from zerocal_sym.io import to_json
-    from zerocal_sym.measurement import NoiseModel
-    from zerocal_sym.paper import format_tables, reproduce
-    from zerocal_sym.tsvd import identify_tsvd
+    from zerocal_sym.io.files import to_json
+    from zerocal_sym.model.noise import NoiseModel
+    from zerocal_sym.paper.reproduction import format_tables, reproduce
+    from zerocal_sym.identify.tsvd import identify_tsvd
 
     robot = load_robot_arg(args)
     if args.trials < 1:

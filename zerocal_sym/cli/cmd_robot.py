@@ -15,8 +15,8 @@ def add_arguments(p):
 
 def run(args):
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.io import to_json
-    from zerocal_sym.robot import validate
+    from zerocal_sym.io.files import to_json
+    from zerocal_sym.model.robot import validate
 
     robot = load_robot_arg(args)
     s = validate(robot)

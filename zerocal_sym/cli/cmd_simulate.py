@@ -5,7 +5,7 @@ paper's frame, i.e. ours mirrored about the x axis, unless ``--frame literal``;
 see docs/reproduction.md) is commanded to the paper's 2n poses through the
 nominal inverse kinematics minus the compensation, and the measuring
 mechanism's scale readings are written in the measurement CSV format
-(``zerocal_sym/data.py``), atomically.
+(``zerocal_sym/io/measurements.py``), atomically.
 
 ``--compensation`` and the commanded angles in the file are in the robot's
 frame (the frame of the robot file and of identification results).
@@ -31,11 +31,11 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.data import write_measurements
+    from zerocal_sym.io.measurements import write_measurements
     from zerocal_sym.errors import PoseError, ZerocalError
-    from zerocal_sym.measurement import NoiseModel, VirtualPlant
-    from zerocal_sym.paper import group_errors, simulate_round
-    from zerocal_sym.scheme import paper_poses
+    from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+    from zerocal_sym.paper.reproduction import group_errors, simulate_round
+    from zerocal_sym.paper.scheme import paper_poses
 
     robot = load_robot_arg(args)
     err = group_errors(args.group, args.frame)

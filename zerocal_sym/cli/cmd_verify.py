@@ -55,11 +55,11 @@ def _declared_compensation(meas):
 def run(args):
     import numpy as np
 
-    from zerocal_sym import data
+    from zerocal_sym.io import measurements as data
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import DataFileError, ZerocalError
-    from zerocal_sym.io import json_safe, to_json, write_json
-    from zerocal_sym.measurement import NoiseModel
+    from zerocal_sym.io.files import json_safe, to_json, write_json
+    from zerocal_sym.model.noise import NoiseModel
 
     if not (args.mu0 > 0 and np.isfinite(args.mu0)):
         raise ZerocalError(f"--mu0 must be a positive number of degrees, got {args.mu0}")
@@ -88,11 +88,11 @@ def run(args):
     if np.all(np.isfinite(applied.maemm_mm)):
         prior[10:12] = applied.maemm_mm
     if args.method == "tsvd":
-        from zerocal_sym.tsvd import identify_tsvd
+        from zerocal_sym.identify.tsvd import identify_tsvd
 
         res = identify_tsvd(robot, meas, prior=prior, noise=None if noise.is_zero else noise)
     else:
-        from zerocal_sym.nlls import identify_nlls
+        from zerocal_sym.identify.nlls import identify_nlls
 
         res = identify_nlls(robot, meas, "paper", noise=noise, prior=prior)
     if not res.success:
@@ -121,7 +121,7 @@ def run(args):
     target = args.plot
     try:
         if args.plot:
-            from zerocal_sym.report_plots import identify_plots
+            from zerocal_sym.report.plots import identify_plots
 
             identify_plots(args.plot, res, meas, robot)
         target = args.out

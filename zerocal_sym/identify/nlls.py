@@ -12,18 +12,18 @@ Weighting (errors-in-variables, marginalised to first order)
     The servo error ``xi`` on the joints is not a latent variable here: it is
     propagated through the kinematics into the covariance of the changes,
     ``C = Cov(s) = sigma_m^2 I + D diag(sigma_xi^2 |d rho/d theta|^2) D^T``
-    (:func:`zerocal_sym.fisher.measurement_covariance`; consecutive changes
+    (:func:`zerocal_sym.identify.fisher.measurement_covariance`; consecutive changes
     are correlated because they share a pose).  The residuals are whitened by
     the inverse Cholesky factor of ``C``, evaluated at the initial point and
     re-evaluated once at the solution (``reweight=1``), so the cost is
     ``0.5 |L^-1 (s - s(p))|^2`` (+ prior terms): a Gaussian negative
     log-likelihood whose Gauss-Newton Hessian is the Fisher information used
-    by :mod:`zerocal_sym.fisher`.
+    by :mod:`zerocal_sym.identify.fisher`.
 
 Scaling
     The optimisation variable is ``z = c * p`` with ``c = L_i`` (mm/rad) for
     the zero offsets (the arc ``L_i dtheta_i``, the paper's ``dq``) and 1 for
-    lengths (:func:`zerocal_sym.fisher.parameter_scale`), so every variable
+    lengths (:func:`zerocal_sym.identify.fisher.parameter_scale`), so every variable
     is in mm; the whitened residuals are in units of their standard deviation.
 
 Hessian
@@ -45,10 +45,10 @@ import time
 
 import numpy as np
 
-from zerocal_sym import fisher
+from zerocal_sym.identify import fisher
 from zerocal_sym.errors import IdentificationError
-from zerocal_sym.measurement import SOURCE_ERROR_NAMES, NoiseModel
-from zerocal_sym.results import IdentificationResult
+from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, NoiseModel
+from zerocal_sym.identify.result import IdentificationResult
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
 UNIT_SIGMA_MM = 1e-3
@@ -195,7 +195,7 @@ def _initial(robot, meas, params, names, prior12, warm_start):
         if warm_start != "tsvd":
             raise ValueError(f"warm_start must be 'tsvd', None or an array, got {warm_start!r}")
         try:
-            from zerocal_sym.tsvd import identify_tsvd
+            from zerocal_sym.identify.tsvd import identify_tsvd
         except ImportError:
             return x0, "prior (tsvd unavailable)"
         try:
@@ -220,7 +220,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     meas : Measurements
         ``theta_cmd`` (K, 2) rad and ``readings`` (K,) mm (``readings[0] = 0``).
     params : str or sequence of str
-        Parameters to estimate (see :func:`zerocal_sym.fisher.param_indices`):
+        Parameters to estimate (see :func:`zerocal_sym.identify.fisher.param_indices`):
         ``"paper"`` (theta1 theta2 rMx rMy), ``"all"``, ``"paper+L1,L2"``, ...
     noise : NoiseModel, optional
         Weights and covariance (default: the paper's noise model).  A zero
@@ -239,7 +239,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         Full Gaussian prior covariance instead of ``prior_std``.
     warm_start : "tsvd", None or ndarray, shape (p,)
         ``"tsvd"``: start from the truncated-SVD estimate (if
-        :mod:`zerocal_sym.tsvd` is available, else from ``prior``).
+        :mod:`zerocal_sym.identify.tsvd` is available, else from ``prior``).
     reweight : int
         Re-evaluate the weights at the solution and solve again this many
         times (the covariance of the changes depends weakly on the estimate).

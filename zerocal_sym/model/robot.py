@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import RobotFileError
-from zerocal_sym.mechanisms import get_mechanism
+from zerocal_sym.model.mechanism import get_mechanism
 
 #: Paper Table 1 (with the OCR-dropped ``ey = 0`` restored), mm.
 PAPER_TABLE1 = dict(ex=80.0, ey=0.0, L=375.0, l=825.0, H=632.0, b=480.0, h=150.0,
@@ -99,7 +99,7 @@ class Robot:
 
     def home_pose(self):
         """Home position P0, mm, ndarray shape (2,)."""
-        from zerocal_sym.kinematics import fk
+        from zerocal_sym.model.kinematics import fk
 
         return fk(self, self.home_joints()[None, :])[0]
 
@@ -188,7 +188,7 @@ def load_robot(path) -> Robot:
         raise RobotFileError(f"units = {keys['units']!r} is not supported: robot files are in mm",
                              where=where("units"))
     mech = keys.get("mechanism", "planar_2dof")
-    from zerocal_sym.mechanisms import REGISTRY
+    from zerocal_sym.model.mechanism import REGISTRY
 
     if mech not in REGISTRY:
         raise RobotFileError(f"unknown mechanism {mech!r} (known: {', '.join(REGISTRY)})", where=where("mechanism"))
@@ -216,7 +216,7 @@ def validate(robot: Robot, where=None) -> dict:
     RobotFileError
     """
     from zerocal_sym.errors import PoseError
-    from zerocal_sym.kinematics import fk, ik, transmission
+    from zerocal_sym.model.kinematics import fk, ik, transmission
 
     where = where or (lambda key: robot.source)
     for key in ("L1", "L2", "l1", "l2"):

@@ -27,7 +27,7 @@ zero source errors.  Per pose k, ``a_k = d rho_k / d p`` (exact, AD of the
 generated distance model) and ``v_k = sigma_xi^2 |d rho_k / d theta|^2``
 (servo error).  The K-1 measured changes have sensitivity ``A = D a`` and
 covariance ``C = sigma_m^2 I + D diag(v) D^T`` (``D`` first differences, see
-:mod:`zerocal_sym.fisher`); ``F = A^T C^-1 A``.
+:mod:`zerocal_sym.identify.fisher`); ``F = A^T C^-1 A``.
 
 Scaling ("q-units"): the offsets are expressed as arc lengths
 ``q = (L1 dth1, L2 dth2, drMx, drMy)`` in mm, the units of the paper's
@@ -104,10 +104,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from zerocal_sym import kinematics as kin
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError, ZerocalError
-from zerocal_sym.io import json_safe
-from zerocal_sym.measurement import NoiseModel
+from zerocal_sym.io.files import json_safe
+from zerocal_sym.model.noise import NoiseModel
 
 #: criterion name -> (description, units, better: "min" | "max")
 CRITERIA = {
@@ -313,7 +313,7 @@ def _pose_terms_fn(mech_name: str):
     """
     import casadi as ca
 
-    from zerocal_sym.mechanisms import get_mechanism
+    from zerocal_sym.model.mechanism import get_mechanism
 
     mech = get_mechanism(mech_name)
     P = ca.SX.sym("P", 2)
@@ -547,7 +547,7 @@ def _pointwise_ok(robot, P, cons: Constraints):
 def paper_baseline(robot, K: int, region: Region | None = None) -> np.ndarray:
     """The paper's scheme with K poses, as the baseline.
 
-    Even K: :func:`zerocal_sym.scheme.paper_poses` with ``n = K/2`` (on the
+    Even K: :func:`zerocal_sym.paper.scheme.paper_poses` with ``n = K/2`` (on the
     region's lower and upper edges when a region is given).  Odd K (the paper
     has none): ``ceil(K/2)`` evenly spaced poses on ``y = ymin`` then
     ``floor(K/2)`` on ``y = ymax``, each from ``xmin`` to ``xmax``.
@@ -557,7 +557,7 @@ def paper_baseline(robot, K: int, region: Region | None = None) -> np.ndarray:
     ndarray, shape (K, 2)
         mm, in visiting order.
     """
-    from zerocal_sym.scheme import paper_poses
+    from zerocal_sym.paper.scheme import paper_poses
 
     ws = Region.workspace(robot)
     region = region or ws
@@ -579,11 +579,12 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     dict
         ``poses`` (K x 2 mm), ``joints_deg``, ``criterion`` {``name``,
         ``value``, ``units``, ``values`` (all five)}, ``crlb_zero_offsets_deg``
-        (2,) from :func:`zerocal_sym.fisher.crlb_zero_offsets_deg`, ``kappa``
+        (2,) from :func:`zerocal_sym.identify.fisher.crlb_zero_offsets_deg`, ``kappa``
         (the paper's kappa_1 of G, no MAEMM prior), ``rho_span_mm``,
         ``min_transmission_sine`` and, with ``cons``, ``violations``.
     """
-    from zerocal_sym import fisher, scheme
+    from zerocal_sym.identify import fisher
+    from zerocal_sym.paper import scheme
 
     P = np.atleast_2d(np.asarray(P, float))
     noise = noise or NoiseModel.paper()
@@ -1222,9 +1223,9 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     """Monte Carlo check of a design's CRLB with the Ipopt estimator.
 
     Each trial simulates the K scale readings of the virtual plant
-    (:class:`~zerocal_sym.measurement.VirtualPlant`) with fresh noise and
+    (:class:`~zerocal_sym.model.noise.VirtualPlant`) with fresh noise and
     identifies the paper's four parameters with
-    :func:`zerocal_sym.nlls.identify_nlls` (same noise model for weighting).
+    :func:`zerocal_sym.identify.nlls.identify_nlls` (same noise model for weighting).
 
     Parameters
     ----------
@@ -1247,10 +1248,10 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         RMS, ``n_trials``, ``n_failed`` (Ipopt not converged, excluded),
         ``time_s``.
     """
-    from zerocal_sym import fisher
-    from zerocal_sym.data import Measurements
-    from zerocal_sym.measurement import VirtualPlant, table2_errors
-    from zerocal_sym.nlls import identify_nlls
+    from zerocal_sym.identify import fisher
+    from zerocal_sym.io.measurements import Measurements
+    from zerocal_sym.model.noise import VirtualPlant, table2_errors
+    from zerocal_sym.identify.nlls import identify_nlls
 
     if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:
         raise DesignError(f"the number of Monte Carlo trials must be a positive integer, got {n_trials!r}")
@@ -1294,7 +1295,7 @@ def plot_design(path, robot, result: DesignResult) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from zerocal_sym.io import atomic_write_bytes
+    from zerocal_sym.io.files import atomic_write_bytes
 
     cons = result.constraints
     ws = Region.workspace(robot)

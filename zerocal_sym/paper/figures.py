@@ -25,7 +25,7 @@ def fig8_data(robot, ns=range(3, 22), maemm_prior=None) -> dict:
     dict
         ``n`` (list of int), ``kappa_1``, ``kappa_m`` (lists of float), ``maemm_prior_mm``.
     """
-    from zerocal_sym.paper import DEFAULT_MAEMM_PRIOR, kappas
+    from zerocal_sym.paper.reproduction import DEFAULT_MAEMM_PRIOR, kappas
 
     prior = DEFAULT_MAEMM_PRIOR if maemm_prior is None else tuple(maemm_prior)
     ns = [int(n) for n in ns]

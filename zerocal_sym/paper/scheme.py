@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym import kinematics as kin
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError
 
 

@@ -27,7 +27,7 @@ Truncation rules (:func:`tsvd_solve`)
     Morozov's discrepancy principle: the smallest ``t`` with
     ``||r_t|| <= tau * delta``, ``delta^2 = sum(noise_std^2)`` the expected
     squared norm of the noise (``tau = 1``).  Needs the noise level, e.g. from
-    a :class:`~zerocal_sym.measurement.NoiseModel` (:func:`identify_tsvd`
+    a :class:`~zerocal_sym.model.noise.NoiseModel` (:func:`identify_tsvd`
     derives it from the measurement covariance).
 
 An explicit ``t`` overrides the rule.  The filter factors of TSVD are 1 for the
@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from zerocal_sym.errors import IdentificationError, PoseError
-from zerocal_sym.results import IdentificationResult
+from zerocal_sym.identify.result import IdentificationResult
 
 RULES = ("threshold", "gcv", "discrepancy")
 DEFAULT_RULE = "threshold"
@@ -217,7 +217,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         ``method = "tsvd"``, params ``theta1 theta2 rMx rMy``.  ``covariance``
         is that of the linear TSVD estimator ``x = A b`` (``A = V_t S_t^-1
         U_t^T``) under the noise model, ``T A C A^T T`` with ``C`` the
-        covariance of the measured changes (:func:`zerocal_sym.fisher.
+        covariance of the measured changes (:func:`zerocal_sym.identify.fisher.
         measurement_covariance`, servo error propagated to first order) and
         ``T`` converting ``L dth`` to ``dth``.  Without a noise model it is
         ``s^2 T A A^T T`` with ``s^2 = ||r||^2 / (K - 1 - t)`` (white noise
@@ -236,9 +236,9 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     PoseError
         A commanded pose that is not an assembly of the robot.
     """
-    from zerocal_sym import kinematics as kin
-    from zerocal_sym.fisher import measurement_covariance
-    from zerocal_sym.scheme import identification_matrix
+    from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.identify.fisher import measurement_covariance
+    from zerocal_sym.paper.scheme import identification_matrix
 
     _validate(meas, robot)
     prior = np.zeros(12) if prior is None else np.asarray(prior, float)

@@ -29,10 +29,10 @@ import time
 
 import numpy as np
 
-from zerocal_sym import fisher
-from zerocal_sym import kinematics as kin
+from zerocal_sym.identify import fisher
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
-from zerocal_sym.measurement import NoiseModel, VirtualPlant
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 
 METHODS = ("tsvd-loop", "tsvd", "nlls", "nlls-loop", "nlls-seq", "scipy")
 
@@ -98,7 +98,7 @@ def _scipy_least_squares():
 def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
     """``scipy.optimize.least_squares`` on the problem Ipopt solves (reference).
 
-    The whitened, scaled residuals of :func:`zerocal_sym.nlls.residual_problem`
+    The whitened, scaled residuals of :func:`zerocal_sym.identify.nlls.residual_problem`
     (weights at ``prior``), Levenberg-Marquardt from ``prior``.
 
     Returns
@@ -108,7 +108,7 @@ def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
     info : dict
         ``success``, ``nfev``, ``cost``, ``time_s`` (the solver call only).
     """
-    from zerocal_sym.nlls import residual_problem
+    from zerocal_sym.identify.nlls import residual_problem
 
     least_squares = _scipy_least_squares()
     fun, jac, scale = residual_problem(robot, meas, params, noise, prior)
@@ -170,10 +170,10 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
         (per trial, mean), ``time_per_identification_ms``; ``scipy``:
         ``max_abs_diff_to_ipopt_deg`` and the time ratio.
     """
-    from zerocal_sym import paper
-    from zerocal_sym.nlls import identify_nlls, make_nlls_identifier
-    from zerocal_sym.scheme import paper_poses
-    from zerocal_sym.tsvd import identify_tsvd
+    from zerocal_sym.paper import reproduction as paper
+    from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
+    from zerocal_sym.paper.scheme import paper_poses
+    from zerocal_sym.identify.tsvd import identify_tsvd
 
     noise = NoiseModel.paper() if noise is None else noise
     unknown = [m for m in methods if m not in METHODS]

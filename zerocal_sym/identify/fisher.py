@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym import kinematics as kin
+from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError
-from zerocal_sym.measurement import SOURCE_ERROR_NAMES, NoiseModel
+from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, NoiseModel
 
 #: Named parameter sets (indices into the source-error vector).
 PARAM_SETS = {

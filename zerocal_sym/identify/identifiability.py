@@ -19,7 +19,7 @@ horizontal -- leaves the other 9 parameters identifiable from enough poses
 (:func:`to_base_gauge` maps any error vector to that gauge exactly).
 
 Scaling: the sensitivity is column-scaled by
-:func:`zerocal_sym.fisher.parameter_scale` (zero offsets as the arc
+:func:`zerocal_sym.identify.fisher.parameter_scale` (zero offsets as the arc
 ``L_i dtheta_i`` in mm, lengths in mm) and row-whitened by the noise model,
 so a singular value ``sigma`` means the corresponding combination (unit
 vector in the scaled mm units) is estimated with standard deviation
@@ -29,9 +29,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym import fisher
-from zerocal_sym import kinematics as kin
-from zerocal_sym.measurement import SOURCE_ERROR_NAMES, NoiseModel
+from zerocal_sym.identify import fisher
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, NoiseModel
 
 #: parameters fixed by the base-joint gauge (A1 exact, A2 on the same horizontal)
 BASE_GAUGE = ("e1x", "e1y", "e2y")

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from zerocal_sym import kinematics as kin
+from zerocal_sym.model import kinematics as kin
 
 SOURCE_ERROR_NAMES = ("theta1", "theta2", "e1x", "e1y", "e2x", "e2y",
                       "L1", "L2", "l1", "l2", "rMx", "rMy")

@@ -32,12 +32,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from zerocal_sym import kinematics as kin
-from zerocal_sym.data import Measurements
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.io.measurements import Measurements
 from zerocal_sym.errors import IdentificationError, PoseError, ZerocalError
-from zerocal_sym.measurement import NoiseModel, VirtualPlant, table2_errors
-from zerocal_sym.scheme import condition_number, identification_matrix, paper_poses
-from zerocal_sym.tsvd import identify_tsvd
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.paper.scheme import condition_number, identification_matrix, paper_poses
+from zerocal_sym.identify.tsvd import identify_tsvd
 
 #: Sign of each source error (SOURCE_ERROR_NAMES order) under the mirror y -> -y.
 MIRROR_Y = np.array([-1, -1, 1, -1, 1, -1, 1, 1, 1, 1, 1, -1], dtype=float)
@@ -456,8 +456,8 @@ def reproduce(robot=None, seed=0, trials=1, noise="paper", n=PAPER_N, frame="pap
         ``kappa`` (``kappa_1``, ``kappa_m`` of the design), ``crlb_zero_offsets_deg``
         (per noise model), ``elapsed_s``.
     """
-    from zerocal_sym.fisher import crlb_zero_offsets_deg
-    from zerocal_sym.robot import paper_robot
+    from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
+    from zerocal_sym.model.robot import paper_robot
 
     robot = robot or paper_robot()
     if trials < 1:

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from zerocal_sym.measurement import SOURCE_ERROR_NAMES
+from zerocal_sym.model.noise import SOURCE_ERROR_NAMES
 
 
 @dataclass
@@ -22,7 +22,7 @@ class IdentificationResult:
     method : str
         ``"tsvd"`` or ``"nlls"`` (or another registered method).
     params : tuple of str
-        Names (from :data:`~zerocal_sym.measurement.SOURCE_ERROR_NAMES`) of the
+        Names (from :data:`~zerocal_sym.model.noise.SOURCE_ERROR_NAMES`) of the
         identified parameters.
     estimate : ndarray, shape (p,)
         Total source errors, rad for zero offsets, mm otherwise.

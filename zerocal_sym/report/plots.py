@@ -30,7 +30,7 @@ import io
 
 import numpy as np
 
-from zerocal_sym.io import atomic_write_bytes
+from zerocal_sym.io.files import atomic_write_bytes
 
 
 # --------------------------------------------------------------------------- figure plumbing
@@ -74,7 +74,7 @@ def residuals_data(result, meas, robot=None) -> dict:
         ``before_mm`` (K-1,) or None; ``rms_after_mm``, ``rms_before_mm``
         (float or None); ``method``.
     """
-    from zerocal_sym import kinematics as kin
+    from zerocal_sym.model import kinematics as kin
 
     r = np.asarray(result.residuals, float)
     if r.shape != (meas.K - 1,):
@@ -167,7 +167,7 @@ def boundary_positions(robot, K: int = 42) -> np.ndarray:
 def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> dict:
     """Position error over the boundary before and after compensation (Fig. 12).
 
-    The errors are computed with the :class:`~zerocal_sym.measurement.VirtualPlant`
+    The errors are computed with the :class:`~zerocal_sym.model.noise.VirtualPlant`
     (noise-free): ``|actual pose - target|`` for the commands ``IK(P)``
     (before) and ``IK(P) - compensation`` (after).
 
@@ -191,8 +191,8 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
         ``after_mm`` (K,), ``max_before_mm``, ``max_after_mm`` (float),
         ``compensation_deg`` (2,).
     """
-    from zerocal_sym.measurement import VirtualPlant
-    from zerocal_sym.paper import position_errors
+    from zerocal_sym.model.noise import VirtualPlant
+    from zerocal_sym.paper.reproduction import position_errors
 
     P = boundary_positions(robot, K) if P is None else np.atleast_2d(np.asarray(P, float))
     comp = np.radians(np.asarray(compensation_deg, float))
@@ -371,8 +371,8 @@ def reproduce_plots(out_dir, rep: dict, robot=None, K: int = 42) -> dict:
     """
     from pathlib import Path
 
-    from zerocal_sym.paper import group_errors, to_table_frame
-    from zerocal_sym.robot import paper_robot
+    from zerocal_sym.paper.reproduction import group_errors, to_table_frame
+    from zerocal_sym.model.robot import paper_robot
 
     robot = robot or paper_robot()
     out_dir = Path(out_dir)

@@ -53,7 +53,7 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io import atomic_write_text
+from zerocal_sym.io.files import atomic_write_text
 
 REQUIRED_COLUMNS = ("pose", "theta1_deg", "theta2_deg", "reading_mm")
 OPTIONAL_COLUMNS = ("x_mm", "y_mm")
@@ -439,7 +439,7 @@ def check_against_robot(meas: Measurements, robot) -> None:
     ------
     DataFileError
     """
-    from zerocal_sym import kinematics as kin
+    from zerocal_sym.model import kinematics as kin
 
     sha = meas.meta.get("robot_sha256")
     if sha and sha != robot.sha256:
@@ -678,7 +678,7 @@ def compensated_commands(robot, P, offsets_deg) -> tuple[np.ndarray, np.ndarray]
     PoseError
         For an unreachable pose.
     """
-    from zerocal_sym import kinematics as kin
+    from zerocal_sym.model import kinematics as kin
 
     nominal = kin.ik(robot, np.atleast_2d(np.asarray(P, float)))
     return nominal, nominal - np.radians(np.asarray(offsets_deg, float))
