@@ -14,7 +14,8 @@ import time
 
 
 
-from zerocal_sym.design import optimize as design
+from zerocal_sym import design
+from zerocal_sym.design import nlp as design_nlp
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.model.robot import paper_robot
 
@@ -48,8 +49,8 @@ def main():
         base = design.paper_baseline(robot, K)
         for crit in a.criteria:
             def one_ipopt():
-                fs, ms = design._scales(robot, base, noise)
-                nlp = design._NLP(robot, K, crit, cons, noise, fs, ms)
+                fs, ms = design_nlp._scales(robot, base, noise)
+                nlp = design_nlp._NLP(robot, K, crit, cons, noise, fs, ms)
                 return nlp.solve(base)
 
             t1, _ = timed(one_ipopt, a.repeat)

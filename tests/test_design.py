@@ -6,12 +6,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from zerocal_sym.design import optimize as design
+from zerocal_sym import design
+from zerocal_sym.design import criteria
+from zerocal_sym.design import nlp as design_nlp
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.paper import scheme
 from zerocal_sym.cli import main
-from zerocal_sym.design.optimize import DesignError
+from zerocal_sym.design import DesignError
 from zerocal_sym.model.noise import NoiseModel
 
 NOISE = NoiseModel.paper()
@@ -53,7 +55,7 @@ def test_odd_k_baseline(robot):
 @given(seed=st.integers(0, 10_000), K=st.integers(5, 9))
 def test_criteria_match_fisher_and_scheme(robot, cons, seed, K):
     """Batched criteria vs fisher.py (CRLB, F) and scheme.py (kappa of G) on random feasible designs."""
-    P = design._random_start(robot, K, cons, np.random.default_rng(seed))
+    P = design_nlp._random_start(robot, K, cons, np.random.default_rng(seed))
     th = kin.ik(robot, P)
     v = design.criterion_values(robot, P, NOISE)
     crlb = fisher.crlb_zero_offsets_deg(robot, th, "paper", NOISE)
@@ -71,11 +73,11 @@ def test_criteria_match_fisher_and_scheme(robot, cons, seed, K):
 def test_symbolic_objective_matches_numeric(robot, cons, criterion):
     """The NLP's symbolic objective (LDL^T of the tridiagonal covariance) equals the numeric one."""
     rng = np.random.default_rng(3)
-    P = design._random_start(robot, 7, cons, rng)
-    fs, ms = design._scales(robot, P, NOISE)
-    nlp = design._NLP(robot, 7, criterion, cons, NOISE, fs, ms)
+    P = design_nlp._random_start(robot, 7, cons, rng)
+    fs, ms = design_nlp._scales(robot, P, NOISE)
+    nlp = design_nlp._NLP(robot, 7, criterion, cons, NOISE, fs, ms)
     f, _ = nlp.fg(nlp.x0(P))
-    o = design._objective(robot, criterion, P, NOISE)
+    o = criteria._objective(robot, criterion, P, NOISE)
     shift = {"D": 4 * np.log(fs), "A": np.log(fs), "crlb": np.log(fs)}[criterion]  # F_n = F / fs
     assert float(f) == pytest.approx(o + shift, rel=1e-8, abs=1e-8)
 
@@ -83,9 +85,9 @@ def test_symbolic_objective_matches_numeric(robot, cons, criterion):
 def test_psd_auxiliary_formulation_gives_eigenvalue_bounds(robot, cons):
     """E and cond: at Ipopt's solution the auxiliary bounds are the extreme eigenvalues."""
     P0 = design.paper_baseline(robot, 6)
-    fs, ms = design._scales(robot, P0, NOISE)
+    fs, ms = design_nlp._scales(robot, P0, NOISE)
     for criterion in ("E", "cond"):
-        nlp = design._NLP(robot, 6, criterion, cons, NOISE, fs, ms)
+        nlp = design_nlp._NLP(robot, 6, criterion, cons, NOISE, fs, ms)
         sol = nlp.solver(x0=nlp.x0(P0), lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
         assert nlp.solver.stats()["success"]
         x = sol["x"].full().ravel()
@@ -131,7 +133,7 @@ def test_exchange_and_continuous_agree(robot, crlb6, cond6):
     for res in (crlb6, cond6):
         ex, co = res.exchange["objective"], res.continuous["objective"]
         assert co <= ex + 0.01  # log scale: continuous within 1 % of (or better than) the exchange
-        assert design._objective(robot, res.criterion, res.poses, NOISE) <= min(ex, co) + 1e-12
+        assert criteria._objective(robot, res.criterion, res.poses, NOISE) <= min(ex, co) + 1e-12
 
 
 def test_best_order_exhaustive(robot):
@@ -149,11 +151,11 @@ def test_best_order_exhaustive(robot):
 
 
 def test_best_order_local_search(robot, cons):
-    P = design._random_start(robot, 10, cons, np.random.default_rng(1))
-    o0 = design._objective(robot, "crlb", P, NOISE)
+    P = design_nlp._random_start(robot, 10, cons, np.random.default_rng(1))
+    o0 = criteria._objective(robot, "crlb", P, NOISE)
     order, obj = design.best_order(robot, P, "crlb", NOISE)
     assert sorted(order) == list(range(10))
-    assert obj <= o0 and design._objective(robot, "crlb", P[order], NOISE) == pytest.approx(obj)
+    assert obj <= o0 and criteria._objective(robot, "crlb", P[order], NOISE) == pytest.approx(obj)
 
 
 # ----------------------------------------------------------------- constraints: one test each

@@ -24,15 +24,16 @@ def _fmt(v, spec=".4g"):
 def run(args):
     import numpy as np
 
-    from zerocal_sym.design import optimize as design
+    from zerocal_sym import design
+    from zerocal_sym.design import constraints, criteria, optimize
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.io.files import to_json
     from zerocal_sym.model.noise import NoiseModel
 
     robot = load_robot_arg(args)
     K = args.K
-    design._check_k(K)
-    design._check_criterion(args.criterion)
+    constraints._check_k(K)
+    criteria._check_criterion(args.criterion)
     verify = int(getattr(args, "verify", 0) or 0)
     if verify < 0:
         raise design.DesignError(f"--verify N needs N >= 0, got {verify}")
@@ -55,8 +56,8 @@ def run(args):
         vd = design.verify_design(robot, res.poses, verify, noise, seed=args.seed)
         vp = design.verify_design(robot, np.asarray(res.paper["poses"]), verify, noise, seed=args.seed)
         out["verify"] = {"design": vd, "paper": vp,
-                         "rms_ratio_design_over_paper": design._ratio(vd["rms_error_rms_deg"],
-                                                                      vp["rms_error_rms_deg"]),
+                         "rms_ratio_design_over_paper": optimize._ratio(vd["rms_error_rms_deg"],
+                                                                        vp["rms_error_rms_deg"]),
                          "estimator": "zerocal_sym.identify.nlls.identify_nlls (Ipopt, exact model, paper's 4 parameters)"}
         out["paper"]["verify"] = vp
     if args.plot:
@@ -138,6 +139,6 @@ def _print_text(out, res):
 
 
 def _desc(name):
-    from zerocal_sym.design.optimize import CRITERIA
+    from zerocal_sym.design import CRITERIA
 
     return CRITERIA[name][0]

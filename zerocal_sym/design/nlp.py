@@ -1,0 +1,297 @@
+"""Continuous design: the Ipopt NLP over the K poses (:func:`continuous_design`).
+
+The K poses (scaled to ``[-1, 1]^2`` over the design region) are the
+decision variables of a CasADi/Ipopt NLP built symbolically from the
+generated mechanism functions; multi-start from seeded random feasible
+designs and from given starts (the paper's scheme).
+
+Smooth reformulations (NLP): ``D``, ``A`` and ``crlb`` are smooth as they
+stand (log det, log trace of the symbolic 4 x 4 inverse).  ``E`` and ``cond``
+are non-smooth where eigenvalues coalesce, so they use auxiliary variables
+and LMI-free eigenvalue constraints: ``max log t`` s.t. ``F_n - t I >= 0``,
+and ``min log(t_hi / t_lo) / 2`` s.t. ``M - t_lo I >= 0``, ``t_hi I - M >= 0``
+(``F_n``, ``M = G^T G`` normalised by their mean eigenvalue at a reference
+design; ``kappa = sqrt(t_hi / t_lo)`` at the optimum).  A 4 x 4 matrix
+inequality ``X >= 0`` is written in one of two exact forms (``psd_form``):
+
+* ``"minors"``: all 15 principal minors >= 0 (used for ``E``);
+* ``"chol"``: ``X = L L^T`` with an auxiliary lower-triangular ``L``
+  (10 variables, ``diag(L) >= 0``, 10 polynomial equalities, linear in
+  ``X``; used for ``cond``, where the minors of ``M - t_lo I``, with
+  ``kappa^2 ~ 1e4``, are badly scaled and most starts hit the iteration limit).
+
+(Only the four *leading* minors would not do: they admit spurious points
+where two minors vanish -- Ipopt stopped at ``t = lambda_2 > lambda_min``.)
+For these two criteria Ipopt starts with a small barrier parameter
+(``mu_init = 1e-6``) so that the auxiliary variables are not pushed away
+from a good start.  See docs/design.md for the measurements.
+"""
+from __future__ import annotations
+
+import itertools
+import time
+
+import numpy as np
+
+from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, _feasible_random_subset,
+                                            _pointwise_ok, check_design, make_constraints)
+from zerocal_sym.design.criteria import (_check_criterion, _fisher_batch, _noise_terms, _objective_batch,
+                                         _terms_batch, _user_value)
+from zerocal_sym.design.terms import _pose_terms_fn, _qscale, pose_terms
+
+#: formulation of the matrix inequalities per criterion (measured best, see module docstring)
+PSD_FORM = {"E": "minors", "cond": "chol"}
+
+
+# --------------------------------------------------------------------------- continuous (Ipopt)
+def _minors(M):
+    """All principal minors of a symbolic 4 x 4 matrix (15): all >= 0 <=> PSD."""
+    import casadi as ca
+
+    out = []
+    for r in range(1, 5):
+        for idx in itertools.combinations(range(4), r):
+            idx = list(idx)
+            out.append(ca.det(M[idx, idx]))
+    return out
+
+
+class _NLP:
+    """The symbolic design NLP for one (robot, K, criterion, constraints, noise)."""
+
+    def __init__(self, robot, K, criterion, cons: Constraints, noise, fscale, mscale, max_iter=500,
+                 psd_form=None, ipopt_options=None):
+        import casadi as ca
+
+        self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
+        psd_form = psd_form or PSD_FORM.get(criterion, "chol")
+        sm2, sx2 = _noise_terms(noise)
+        qs = _qscale(robot)
+        c, h = cons.region.center, cons.region.half
+        z = ca.SX.sym("z", 2, K)
+        P = ca.repmat(ca.DM(c), 1, K) + ca.repmat(ca.DM(h), 1, K) * z
+        f = _pose_terms_fn(robot.mechanism_name).map(K)
+        theta, ratio, s, rho, a, dth = f(P, robot.geometry)
+        aq = ca.repmat(ca.DM(qs), 1, K) * a
+        v = sx2 * ca.sum1(dth ** 2)
+        g, lbg, ubg = [], [], []
+
+        def add(expr, lo, hi):
+            expr = ca.vec(expr)
+            g.append(expr)
+            lbg.append(np.broadcast_to(lo, expr.shape[0]).astype(float))
+            ubg.append(np.broadcast_to(hi, expr.shape[0]).astype(float))
+
+        add(ratio, -1 + 1e-9, 1 - 1e-9)
+        if cons.singularity_margin > 0:
+            add(s ** 2, (cons.singularity_margin + 1e-7) ** 2, np.inf)
+        if cons.joint_limits_deg is not None:
+            jl = np.radians(np.asarray(cons.joint_limits_deg))
+            add(theta[0, :], jl[0, 0] + 1e-9, jl[0, 1] - 1e-9)
+            add(theta[1, :], jl[1, 0] + 1e-9, jl[1, 1] - 1e-9)
+        aux = []  # (name, symbol column, lb, ub, init(nums) -> values)
+        l0 = cons.travel_mm
+        if cons.travel_mode == "range":
+            r = ca.SX.sym("r", 2)  # rho window, scaled by 1/l0
+            aux.append(("rho window", r, -np.inf, np.inf,
+                        lambda n: np.array([n["rho"].min(), n["rho"].max()]) / l0))
+            add(rho / l0 - r[0], 0, np.inf)
+            add(r[1] - rho / l0, 0, np.inf)
+            add(r[1] - r[0], -np.inf, 1 - 1e-9)
+        else:
+            add((rho[1:] - rho[:-1]) / l0, -1 + 1e-9, 1 - 1e-9)
+        if cons.min_separation_mm > 0:
+            d2 = [ca.sumsqr(P[:, i] - P[:, j]) / 1e4 for i in range(K) for j in range(i + 1, K)]
+            add(ca.vertcat(*d2), (cons.min_separation_mm + 1e-6) ** 2 / 1e4, np.inf)
+
+        def psd(name, X, X0):
+            """X (symbolic 4 x 4) >= 0 as X = L L^T with L lower-triangular (auxiliary)."""
+            if psd_form == "minors":
+                add(ca.vertcat(*_minors(X)), 0, np.inf)
+                return
+            tri = [(i, j) for i in range(4) for j in range(i + 1)]
+            lv = ca.SX.sym(name, len(tri))
+            Lm = ca.SX.zeros(4, 4)
+            for k, (i, j) in enumerate(tri):
+                Lm[i, j] = lv[k]
+            R = X - Lm @ Lm.T
+            add(ca.vertcat(*[R[i, j] for i, j in tri]), 0, 0)
+            lb = np.array([0.0 if i == j else -np.inf for i, j in tri])
+
+            def init(n):
+                Xn = X0(n)
+                Lc = np.linalg.cholesky(Xn + 1e-12 * max(np.trace(Xn), 1e-12) * np.eye(4))
+                return np.array([Lc[i, j] for i, j in tri])
+
+            aux.append((name, lv, lb, np.inf, init))
+
+        # differences and Fisher information (LDL^T of the tridiagonal covariance)
+        b = [aq[:, i + 1] - aq[:, i] for i in range(K - 1)]
+        if criterion == "cond":
+            M = sum((bi @ bi.T for bi in b), ca.SX.zeros(4, 4)) / mscale
+            tl = ca.SX.sym("tlo")
+            th_ = ca.SX.sym("thi")
+            aux.append(("tlo", tl, 1e-12, np.inf, lambda n: max(0.5 * n["wM"][0], 1e-12)))
+            aux.append(("thi", th_, 1e-12, np.inf, lambda n: 1.5 * n["wM"][-1]))
+            psd("Llo", M - tl * ca.SX.eye(4), lambda n: n["M"] - 0.5 * n["wM"][0] * np.eye(4))
+            psd("Lhi", th_ * ca.SX.eye(4) - M, lambda n: 1.5 * n["wM"][-1] * np.eye(4) - n["M"])
+            obj = 0.5 * (ca.log(th_) - ca.log(tl))
+        else:
+            d = [sm2 + v[i] + v[i + 1] for i in range(K - 1)]
+            e = [-v[i + 1] for i in range(K - 2)]
+            Dp, w = d[0], b[0]
+            F = w @ w.T / Dp
+            for i in range(1, K - 1):
+                m = e[i - 1] / Dp
+                Dp = d[i] - m * e[i - 1]
+                w = b[i] - m * w
+                F = F + w @ w.T / Dp
+            Fn = F / fscale
+            if criterion == "D":
+                obj = -ca.log(ca.det(Fn))
+            elif criterion == "E":
+                tt = ca.SX.sym("t")
+                aux.append(("t", tt, 1e-12, np.inf, lambda n: max(0.5 * n["wF"][0], 1e-12)))
+                psd("L", Fn - tt * ca.SX.eye(4), lambda n: n["Fn"] - 0.5 * n["wF"][0] * np.eye(4))
+                obj = -ca.log(tt)
+            else:
+                Finv = ca.inv(Fn)
+                if criterion == "A":
+                    obj = ca.log(ca.trace(Finv))
+                else:
+                    obj = ca.log(Finv[0, 0] * qs[0] ** 2 + Finv[1, 1] * qs[1] ** 2)
+        self.aux = aux
+        x = ca.vertcat(ca.vec(z), *[a_[1] for a_ in aux])
+        self.lbx = np.concatenate([-np.ones(2 * K)] + [np.broadcast_to(a_[2], a_[1].shape[0]) for a_ in aux])
+        self.ubx = np.concatenate([np.ones(2 * K)] + [np.broadcast_to(a_[3], a_[1].shape[0]) for a_ in aux])
+        self.lbg = np.concatenate(lbg)
+        self.ubg = np.concatenate(ubg)
+        self.fscale, self.mscale = fscale, mscale
+        opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": max_iter,
+                "ipopt.tol": 1e-10, "ipopt.acceptable_tol": 1e-7, "ipopt.constr_viol_tol": 1e-9,
+                "ipopt.bound_relax_factor": 0.0, "error_on_fail": False}
+        if criterion in ("cond", "E"):
+            opts["ipopt.mu_init"] = 1e-6
+        opts.update(ipopt_options or {})
+        self.solver = ca.nlpsol("design", "ipopt", {"x": x, "f": obj, "g": ca.vertcat(*g)}, opts)
+        #: objective and constraints as a Function of x (for checks)
+        self.fg = ca.Function("design_fg", [x], [obj, ca.vertcat(*g)])
+        self.sm2, self.sx2, self.qs = sm2, sx2, qs
+
+    def x0(self, P0):
+        """Initial point from a design (auxiliary variables from its numeric values)."""
+        cons = self.cons
+        z0 = np.clip((np.asarray(P0) - cons.region.center) / cons.region.half, -1, 1)
+        t = pose_terms(self.robot, P0)
+        aq = t["a"] * self.qs
+        G = np.diff(aq, axis=0)
+        v = self.sx2 * np.sum(t["dth"] ** 2, axis=1)
+        nums = {"rho": t["rho"], "M": G.T @ G / self.mscale,
+                "Fn": _fisher_batch(aq[None], v[None], self.sm2)[0] / self.fscale}
+        nums["wM"] = np.linalg.eigvalsh(nums["M"])
+        nums["wF"] = np.linalg.eigvalsh(nums["Fn"])
+        aux = [np.atleast_1d(a_[4](nums)) for a_ in self.aux]
+        return np.concatenate([z0.ravel()] + aux)  # z is (2, K) column-major == P0 row-major
+
+    def solve(self, P0):
+        """Run Ipopt from ``P0`` (K, 2); returns (P, status, iterations)."""
+        sol = self.solver(x0=self.x0(P0), lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        st = self.solver.stats()
+        x = sol["x"].full().ravel()
+        z = np.clip(x[:2 * self.K].reshape(self.K, 2), -1, 1)
+        P = self.cons.region.center + self.cons.region.half * z
+        return P, st.get("return_status", "?"), int(st.get("iter_count", -1))
+
+
+def _random_start(robot, K, cons, rng, tries=50):
+    """A random design of K feasible, separated poses (None if none found)."""
+    for _ in range(tries):
+        pts = cons.region.lo + rng.uniform(size=(40 * K, 2)) * (cons.region.hi - cons.region.lo)
+        pts = pts[_pointwise_ok(robot, pts, cons)]
+        if len(pts) < K:
+            continue
+        rho = pose_terms(robot, pts)["rho"]
+        close = None
+        if cons.min_separation_mm > 0:
+            close = np.linalg.norm(pts[:, None] - pts[None], axis=2) < cons.min_separation_mm
+            np.fill_diagonal(close, False)
+        idx = _feasible_random_subset(rng, rho, K, cons, tries=20, close=close)
+        if idx is None:
+            continue
+        P = pts[idx]
+        if not check_design(robot, P, cons):
+            return P
+    return None
+
+
+def _scales(robot, P, noise):
+    """Normalisations of F_q and G^T G (mean eigenvalue at a reference design)."""
+    sm2, sx2 = _noise_terms(noise)
+    t = pose_terms(robot, P)
+    aq = t["a"] * _qscale(robot)
+    v = sx2 * np.sum(t["dth"] ** 2, axis=1)
+    F = _fisher_batch(aq[None], v[None], sm2)[0]
+    G = np.diff(aq, axis=0)
+    return max(np.trace(F) / 4, 1e-300), max(np.trace(G.T @ G) / 4, 1e-300)
+
+
+def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
+                      n_starts: int = 8, starts=None, max_iter: int = 500):
+    """Multi-start Ipopt over the K poses.
+
+    Parameters
+    ----------
+    robot : Robot
+    K : int
+    criterion : {"cond", "D", "A", "E", "crlb"}
+    cons : Constraints, optional
+    noise : NoiseModel, optional
+        Default: the paper's (scale and servo errors).
+    seed : int
+        Seed of the random starts.
+    n_starts : int
+        Number of random starts.
+    starts : list of (label, ndarray shape (K, 2)), optional
+        Extra starts (e.g. the paper's scheme, an exchange design).
+
+    Returns
+    -------
+    dict
+        ``poses`` (K, 2) of the best feasible local optimum, ``objective``,
+        ``value`` (user units), ``runs`` (label, value, status, iterations,
+        feasible, time per start), ``time_s``, ``build_s``.
+    """
+    t0 = time.perf_counter()
+    cons = cons or make_constraints(robot)
+    _check_k(K)
+    _check_criterion(criterion)
+    rng = np.random.default_rng(seed)
+    all_starts = list(starts or [])
+    for i in range(n_starts):
+        P0 = _random_start(robot, K, cons, rng)
+        if P0 is not None:
+            all_starts.append((f"random {i}", P0))
+    if not all_starts:
+        raise DesignError("could not find a feasible random start: the constraints leave (almost) no room")
+    ref = next((P for _, P in all_starts if np.isfinite(_objective_batch(
+        "D", *_terms_batch(robot, P, noise), _noise_terms(noise)[0], _qscale(robot))[0])), all_starts[0][1])
+    fscale, mscale = _scales(robot, ref, noise)
+    nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter)
+    build_s = time.perf_counter() - t0
+    best, runs = None, []
+    sm2 = _noise_terms(noise)[0]
+    qs = _qscale(robot)
+    for label, P0 in all_starts:
+        ts = time.perf_counter()
+        P, status, iters = nlp.solve(P0)
+        viol = check_design(robot, P, cons)
+        o = float(_objective_batch(criterion, *_terms_batch(robot, P, noise), sm2, qs)[0])
+        runs.append({"start": label, "value": _user_value(criterion, o), "status": status, "iterations": iters,
+                     "feasible": not viol, "time_s": time.perf_counter() - ts})
+        if not viol and np.isfinite(o) and (best is None or o < best[1]):
+            best = (P, o)
+    if best is None:
+        raise DesignError("no Ipopt start ended at a feasible design; statuses: "
+                          + ", ".join(sorted({r["status"] for r in runs})))
+    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1]), "runs": runs,
+            "time_s": time.perf_counter() - t0, "build_s": build_s, "nlp": nlp}
