@@ -45,7 +45,7 @@ def main():
     from scipy.optimize import least_squares
 
     from zerocal_sym.model import kinematics as kin
-    from zerocal_sym.io.measurements import Measurements
+    from zerocal_sym.model.measurements import Measurements
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
     from zerocal_sym.identify.nlls import get_problem, identify_nlls, residual_problem
     from zerocal_sym.report.plots import boundary_positions

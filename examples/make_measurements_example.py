@@ -23,6 +23,7 @@ from zerocal_sym.io import measurements as data
 from zerocal_sym.model import kinematics
 from zerocal_sym.paper import scheme
 from zerocal_sym.io.files import atomic_write_text
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.paper.reproduction import group_errors
 from zerocal_sym.model.robot import paper_robot
@@ -51,7 +52,7 @@ def make_example():
                          "(examples/make_measurements_example.py)",
             "true_zero_offsets_deg": " ".join(f"{v:.10g}" for v in np.degrees(err[:2])),
             "true_maemm_mm": " ".join(f"{v:.10g}" for v in err[10:12])}
-    return data.Measurements(theta, readings, P, meta)
+    return Measurements(theta, readings, P, meta)
 
 
 def main():

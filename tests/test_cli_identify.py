@@ -6,7 +6,9 @@ import pytest
 
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.cli import main
-from zerocal_sym.io.measurements import Measurements, load_result, write_measurements
+from zerocal_sym.io.measurements import write_measurements
+from zerocal_sym.io.results import load_result
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
 from zerocal_sym.paper.scheme import paper_poses
 

@@ -7,7 +7,7 @@ import pytest
 
 from zerocal_sym.cli import main
 from zerocal_sym.identify.compare import METHODS, Progress, compare, format_compare, scipy_identify
-from zerocal_sym.io.measurements import Measurements
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors

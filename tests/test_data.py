@@ -11,9 +11,13 @@ import numpy as np
 import pytest
 
 from zerocal_sym.io import measurements as data
+from zerocal_sym.io.compensation import compensated_commands, format_compensation
+from zerocal_sym.io.poses import load_poses
+from zerocal_sym.io.results import load_result
 from zerocal_sym.model import kinematics
 from zerocal_sym.paper import scheme
 from zerocal_sym.errors import DataFileError
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,7 +34,7 @@ def good_meas():
     P = scheme.paper_poses(robot, 3)
     th = kinematics.ik(robot, P)
     s = VirtualPlant(robot, table2_errors(1)).measure(th, NoiseModel.paper(), 7)
-    return data.Measurements(th, s, P, {"robot_sha256": robot.sha256})
+    return Measurements(th, s, P, {"robot_sha256": robot.sha256})
 
 
 @pytest.fixture
@@ -286,7 +290,7 @@ def test_pose_outside_workspace(tmp_path, good_meas, robot):
     P = good_meas.target.copy()
     P[2] = (400.0, 700.0)   # reachable, outside the 480 x 150 rectangle
     th = kinematics.ik(robot, P)
-    text = data.format_measurements(data.Measurements(th, good_meas.readings, None))
+    text = data.format_measurements(Measurements(th, good_meas.readings, None))
     msg = expect(tmp_path, text, r"commanded pose \(400.000, 700.000\) mm is outside the workspace",
                  line=data_line(text, 2), robot=robot)
     assert "x in [-240, 240]" in msg
@@ -329,7 +333,7 @@ def test_unassemblable_pose(tmp_path, good_text):
 
 def test_radians_instead_of_degrees(tmp_path, good_meas, robot):
     deg = good_meas.theta_cmd.copy()
-    text = data.format_measurements(data.Measurements(np.radians(deg), good_meas.readings, good_meas.target))
+    text = data.format_measurements(Measurements(np.radians(deg), good_meas.readings, good_meas.target))
     expect(tmp_path, text, r"pose 0|not an assembly|outside the workspace|from the target", robot=robot,
            line=data_line(text, 0))
 
@@ -400,22 +404,22 @@ def test_unsupported_version(tmp_path, good_text):
 
 def test_load_poses(tmp_path, robot):
     p = write(tmp_path, "# my poses\nx_mm,y_mm\n-240,632\n0,700\n", "p.csv")
-    np.testing.assert_array_equal(data.load_poses(p, robot), [[-240, 632], [0, 700]])
+    np.testing.assert_array_equal(load_poses(p, robot), [[-240, 632], [0, 700]])
     p = write(tmp_path, "pose,x_mm,y_mm\n0,-240,632\n1,0,900\n", "p.csv")
     with pytest.raises(DataFileError, match=r"p.csv:3: pose 1 \(0, 900\) mm is outside the workspace"):
-        data.load_poses(p, robot)
+        load_poses(p, robot)
     p = write(tmp_path, "x_mm,z_mm\n1,2\n", "p.csv")
     with pytest.raises(DataFileError, match=r"p.csv:1: unexpected column"):
-        data.load_poses(p)
+        load_poses(p)
     p = write(tmp_path, "x_mm,y_mm\n", "p.csv")
     with pytest.raises(DataFileError, match=r"p.csv:1: no data rows"):
-        data.load_poses(p)
+        load_poses(p)
     # a design JSON (zerocal design --json)
     p = write(tmp_path, json.dumps({"K": 2, "poses": [[-240, 632], [240, 782.0]]}, indent=1), "d.json")
-    np.testing.assert_array_equal(data.load_poses(p, robot), [[-240, 632], [240, 782]])
+    np.testing.assert_array_equal(load_poses(p, robot), [[-240, 632], [240, 782]])
     p = write(tmp_path, json.dumps({"K": 2, "poses": [[-240, 632], [240]]}, indent=1), "d.json")
     with pytest.raises(DataFileError, match=r"d.json:3: key 'poses' must be a non-empty list of \[x_mm, y_mm\]"):
-        data.load_poses(p, robot)
+        load_poses(p, robot)
 
 
 def _result_json(**over):
@@ -426,7 +430,7 @@ def _result_json(**over):
 
 
 def test_load_result(tmp_path):
-    r = data.load_result(write(tmp_path, _result_json(robot_sha256="ab"), "r.json"))
+    r = load_result(write(tmp_path, _result_json(robot_sha256="ab"), "r.json"))
     np.testing.assert_array_equal(r.zero_offsets_deg, [2.0, -1.0])
     assert r.std_zero_offsets_deg[0] == 0.05 and np.isnan(r.std_zero_offsets_deg[1])
     assert r.robot_sha256 == "ab" and r.method == "tsvd" and r.success
@@ -445,7 +449,7 @@ def test_load_result(tmp_path):
 def test_bad_result(tmp_path, text, pattern):
     p = write(tmp_path, text, "r.json")
     with pytest.raises(DataFileError, match=pattern):
-        data.load_result(p)
+        load_result(p)
 
 
 def test_compensated_commands_sign(robot):
@@ -453,15 +457,15 @@ def test_compensated_commands_sign(robot):
     P = scheme.paper_poses(robot, 3)
     err = np.zeros(12)
     err[:2] = np.radians([2.0, -1.0])
-    nominal, cmd = data.compensated_commands(robot, P, [2.0, -1.0])
+    nominal, cmd = compensated_commands(robot, P, [2.0, -1.0])
     np.testing.assert_allclose(np.degrees(nominal - cmd), np.broadcast_to([2.0, -1.0], (6, 2)), atol=1e-12)
     np.testing.assert_allclose(VirtualPlant(robot, err).actual_pose(cmd), P, atol=1e-8)
     assert np.max(np.linalg.norm(VirtualPlant(robot, err).actual_pose(nominal) - P, axis=1)) > 5
 
 
 def test_compensation_table_states_the_sign(tmp_path):
-    r = data.load_result(write(tmp_path, _result_json(), "r.json"))
-    text = data.format_compensation(r)
+    r = load_result(write(tmp_path, _result_json(), "r.json"))
+    text = format_compensation(r)
     assert "theta_cmd = IK(P) - offset_deg" in text
     rows = [ln for ln in text.splitlines() if not ln.startswith("#")]
     assert rows == ["joint,offset_deg,std_deg", "theta1,2.0,0.05", "theta2,-1.0,"]

@@ -7,7 +7,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from zerocal_sym.io import measurements as data
+from zerocal_sym.io.poses import load_poses
+from zerocal_sym.io.results import load_result
 from zerocal_sym.errors import DataFileError
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.robot import paper_robot
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -21,7 +24,7 @@ TOKENS = [",", "\n", "\r", "\r\n", " ", "#", '"', "'", ";", "\t", "\x00", "\ufef
 
 
 def check_measurements(m):
-    assert isinstance(m, data.Measurements)
+    assert isinstance(m, Measurements)
     K = m.K
     assert K >= data.MIN_POSES
     assert m.theta_cmd.shape == (K, 2) and np.all(np.isfinite(m.theta_cmd))
@@ -126,7 +129,7 @@ def test_result_loader(tmp_path, text):
     p = tmp_path / "r.json"
     p.write_bytes(text.encode("utf-8", "surrogatepass"))
     try:
-        r = data.load_result(p)
+        r = load_result(p)
     except DataFileError:
         return
     assert r.zero_offsets_deg.shape == (2,) and np.all(np.isfinite(r.zero_offsets_deg))
@@ -139,7 +142,7 @@ def test_pose_loader(tmp_path, text, header):
     p = tmp_path / "p.csv"
     p.write_text(header + text)
     try:
-        P = data.load_poses(p, ROBOT)
+        P = load_poses(p, ROBOT)
     except DataFileError:
         return
     assert P.ndim == 2 and P.shape[1] == 2 and np.all(np.isfinite(P))

@@ -9,6 +9,7 @@ import pytest
 from zerocal_sym.io import measurements as data
 from zerocal_sym.model import kinematics
 from zerocal_sym.report import plots as rp
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.paper.reproduction import calibration_loop, group_errors
 from zerocal_sym.paper.scheme import paper_poses
@@ -83,7 +84,7 @@ def test_residuals_data(robot):
     # the nominal model (no errors) misses the changes by millimetres, the estimate by tens of um
     assert d["rms_before_mm"] > 1.0 and d["rms_after_mm"] < 0.1
     assert rp.residuals_data(res, meas)["before_mm"] is None
-    bad = data.Measurements(meas.theta_cmd[:5], meas.readings[:5])
+    bad = Measurements(meas.theta_cmd[:5], meas.readings[:5])
     with pytest.raises(ValueError, match="residuals"):
         rp.residuals_data(res, bad)
 

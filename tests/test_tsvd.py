@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from zerocal_sym.model import kinematics as kin
-from zerocal_sym.io.measurements import Measurements
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant, source_errors

@@ -67,7 +67,7 @@ def run(args):
 
         poses = paper_poses(robot, args.n)
     else:
-        from zerocal_sym.io.measurements import load_poses
+        from zerocal_sym.io.poses import load_poses
 
         poses = load_poses(args.poses, robot)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]

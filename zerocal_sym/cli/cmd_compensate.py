@@ -43,10 +43,14 @@ def add_arguments(p):
 def run(args):
     import numpy as np
 
-    from zerocal_sym.io import measurements as data
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import DataFileError, ZerocalError
+    from zerocal_sym.io.compensation import (SIGN_CONVENTION, compensated_commands, format_commands,
+                                             format_compensation)
     from zerocal_sym.io.files import atomic_write_text, to_json
+    from zerocal_sym.io.measurements import format_template
+    from zerocal_sym.io.poses import load_poses
+    from zerocal_sym.io.results import load_result
 
     robot = load_robot_arg(args)
     has_poses = args.poses is not None or args.scheme is not None
@@ -56,7 +60,7 @@ def run(args):
     if args.template and not has_poses:
         raise ZerocalError("--template needs the poses: --poses FILE.csv or --scheme paper --n N")
     if args.result is not None:
-        res = data.load_result(args.result)
+        res = load_result(args.result)
         if res.robot_sha256 and res.robot_sha256 != robot.sha256:
             raise DataFileError(f"identified on another robot (robot_sha256 {res.robot_sha256[:12]}..., "
                                 f"{robot.sha256[:12]}... for {robot.source}): pass the same --robot as to identify",
@@ -74,32 +78,32 @@ def run(args):
     if args.result is not None:
         meta["result"] = args.result
     if not has_poses:
-        text, what, K = data.format_compensation(res, {"result": args.result}), "compensation table", 0
+        text, what, K = format_compensation(res, {"result": args.result}), "compensation table", 0
     else:
         if args.poses is not None:
-            P = data.load_poses(args.poses, robot)
+            P = load_poses(args.poses, robot)
         else:
             from zerocal_sym.paper.scheme import paper_poses
 
             P = paper_poses(robot, args.n)
-        nominal, cmd = data.compensated_commands(robot, P, offsets)
+        nominal, cmd = compensated_commands(robot, P, offsets)
         K = len(P)
         if args.template:
             meta["compensation_deg"] = f"{float(offsets[0])!r}, {float(offsets[1])!r}"
-            text, what = data.format_template(cmd, P, meta), "measurement template"
+            text, what = format_template(cmd, P, meta), "measurement template"
         else:
-            text, what = data.format_commands(P, nominal, cmd, offsets, meta), "compensated commands"
+            text, what = format_commands(P, nominal, cmd, offsets, meta), "compensated commands"
     if args.out:
         try:
             atomic_write_text(args.out, text)
         except OSError as exc:
             raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=args.out) from None
     if args.json:
-        print(to_json({"zero_offsets_deg": [float(v) for v in offsets], "sign_convention": data.SIGN_CONVENTION,
+        print(to_json({"zero_offsets_deg": [float(v) for v in offsets], "sign_convention": SIGN_CONVENTION,
                        "output": args.out, "kind": what, "poses": K}))
     elif args.out:
         print(f"wrote {what} ({K} poses) to {args.out}" if K else f"wrote {what} to {args.out}")
-        print(f"offsets [deg]: theta1 {offsets[0]:+.6f}, theta2 {offsets[1]:+.6f}; {data.SIGN_CONVENTION}")
+        print(f"offsets [deg]: theta1 {offsets[0]:+.6f}, theta2 {offsets[1]:+.6f}; {SIGN_CONVENTION}")
     else:
         print(text, end="")
     return 0

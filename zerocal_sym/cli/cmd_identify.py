@@ -81,7 +81,7 @@ def result_json(robot, meas, res, report, source) -> dict:
     """The results JSON: IdentificationResult.to_dict plus robot, data, compensation, identifiability."""
     import numpy as np
 
-    from zerocal_sym.io.measurements import SIGN_CONVENTION
+    from zerocal_sym.io.compensation import SIGN_CONVENTION
 
     d = res.to_dict()
     keep = ("solver_status", "iterations", "cost", "chi2", "dof", "time_s", "weighting", "warm_start", "rank",

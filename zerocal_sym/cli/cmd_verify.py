@@ -55,10 +55,12 @@ def _declared_compensation(meas):
 def run(args):
     import numpy as np
 
-    from zerocal_sym.io import measurements as data
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import DataFileError, ZerocalError
+    from zerocal_sym.io.compensation import SIGN_CONVENTION
     from zerocal_sym.io.files import json_safe, to_json, write_json
+    from zerocal_sym.io.measurements import load_measurements
+    from zerocal_sym.io.results import load_result
     from zerocal_sym.model.noise import NoiseModel
 
     if not (args.mu0 > 0 and np.isfinite(args.mu0)):
@@ -70,11 +72,11 @@ def run(args):
             raise ZerocalError(f"{opt} {path}: {'is a directory' if opt == '--out' else 'is not a directory'}",
                                where=path)
     robot = load_robot_arg(args)
-    applied = data.load_result(args.result)
+    applied = load_result(args.result)
     if applied.robot_sha256 and applied.robot_sha256 != robot.sha256:
         raise DataFileError(f"identified on another robot (robot_sha256 {applied.robot_sha256[:12]}..., "
                             f"{robot.sha256[:12]}... for {robot.source}): pass the same --robot", where=args.result)
-    meas = data.load_measurements(args.data, robot)
+    meas = load_measurements(args.data, robot)
     declared = _declared_compensation(meas)
     if declared is not None and np.max(np.abs(declared - applied.zero_offsets_deg)) > 1e-4:
         line = meas.meta_lines.get("compensation_deg")
@@ -116,7 +118,7 @@ def run(args):
     }
     out = res.to_dict()
     out.update(robot_sha256=robot.sha256, verification=report,
-               compensation={"sign_convention": data.SIGN_CONVENTION, "joints": ["theta1", "theta2"],
+               compensation={"sign_convention": SIGN_CONVENTION, "joints": ["theta1", "theta2"],
                              "offset_deg": new.tolist(), "std_deg": report["std_new_offsets_deg"]})
     target = args.plot
     try:

@@ -42,7 +42,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         ``time_s``.
     """
     from zerocal_sym.identify import fisher
-    from zerocal_sym.io.measurements import Measurements
+    from zerocal_sym.model.measurements import Measurements
     from zerocal_sym.model.noise import VirtualPlant, table2_errors
     from zerocal_sym.identify.nlls import identify_nlls
 

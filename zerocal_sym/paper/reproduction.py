@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
-from zerocal_sym.io.measurements import Measurements
+from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.errors import IdentificationError, PoseError, ZerocalError
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
 from zerocal_sym.paper.scheme import condition_number, identification_matrix, paper_poses

@@ -1,0 +1,198 @@
+"""Shared text handling of the data files: reading, CSV splitting, cell checks.
+
+Used by the measurement file (:mod:`zerocal_sym.io.measurements`), the pose
+file (:mod:`zerocal_sym.io.poses`), the results JSON
+(:mod:`zerocal_sym.io.results`) and the compensation table
+(:mod:`zerocal_sym.io.compensation`).  Columns may come in any order; the
+separator is a comma; ``#`` starts a comment line; blank lines are ignored; a
+UTF-8 byte-order mark is accepted.  Every error is a
+:class:`~zerocal_sym.errors.DataFileError` naming the file, the line and,
+where there is one, the column (by name and field number).
+"""
+from __future__ import annotations
+
+import csv
+import difflib
+import json
+import math
+import re
+from pathlib import Path
+
+from zerocal_sym.errors import DataFileError
+
+#: plausibility limits of the cells (anything beyond is a unit or typing error)
+ANGLE_LIMIT_DEG = 3600.0
+LENGTH_LIMIT_MM = 1e6
+
+
+def _format_meta(meta: dict) -> str:
+    out = []
+    for k, v in meta.items():
+        k, v = str(k).strip(), str(v).strip()
+        if not k or ":" in k or "\n" in k + v or "\r" in k + v:
+            raise ValueError(f"metadata key {k!r} / value {v!r} cannot be written on one '# key: value' line")
+        out.append(f"# {k}: {v}\n")
+    return "".join(out)
+
+
+def _read_text(path, what="file") -> tuple[str, str]:
+    """File text with BOM removed and newlines normalised; typed errors."""
+    path = Path(path)
+    src = str(path)
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        raise DataFileError(f"{what} not found", where=src) from None
+    except IsADirectoryError:
+        raise DataFileError(f"{what} is a directory", where=src) from None
+    except OSError as exc:
+        raise DataFileError(f"cannot read {what}: {exc.strerror or exc}", where=src) from None
+    if raw.startswith(b"\xef\xbb\xbf"):
+        raw = raw[3:]
+    elif raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise DataFileError("file is UTF-16 encoded: save it as UTF-8 (plain CSV)", where=f"{src}:1")
+    nul = raw.find(b"\x00")
+    if nul >= 0:
+        line = raw.count(b"\n", 0, nul) + 1
+        raise DataFileError("binary data (NUL byte) in a text file", where=f"{src}:{line}")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        before = raw[:exc.start]
+        line = before.count(b"\n") + 1
+        col = exc.start - (before.rfind(b"\n") + 1) + 1
+        raise DataFileError(f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at column {col} "
+                            "(save the file as UTF-8 CSV)", where=f"{src}:{line}") from None
+    return text.replace("\r\n", "\n").replace("\r", "\n"), src
+
+
+def _split_csv(text: str, src: str, format_prefix: str | None = None, version: int | None = None):
+    """Metadata lines, their line numbers and CSV rows (line number, stripped cells)."""
+    meta, meta_lines, rows = {}, {}, []
+    header_seen = False
+    for lineno, line in enumerate(text.split("\n"), 1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            if format_prefix and stripped.startswith(format_prefix):
+                m = re.fullmatch(re.escape(format_prefix) + r" v(\d+)", stripped)
+                if not m or int(m.group(1)) != version:
+                    raise DataFileError(f"unsupported format line {stripped[:60]!r} (this version reads "
+                                        f"'{format_prefix} v{version}')", where=f"{src}:{lineno}")
+            elif not header_seen and ":" in stripped:
+                k, _, v = stripped[1:].partition(":")
+                meta[k.strip()] = v.strip()
+                meta_lines[k.strip()] = lineno
+            continue
+        try:
+            cells = next(csv.reader([line], strict=True))
+        except csv.Error as exc:
+            raise DataFileError(f"malformed CSV line ({exc})", where=f"{src}:{lineno}") from None
+        rows.append((lineno, [c.strip() for c in cells]))
+        header_seen = True
+    return meta, meta_lines, rows
+
+
+def _looks_numeric(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_header(header, header_line, src, allowed, required, example):
+    where = f"{src}:{header_line}"
+    if len(header) == 1 and (";" in header[0] or "\t" in header[0]):
+        sep = "';'" if ";" in header[0] else "a tab"
+        raise DataFileError(f"the separator must be a comma, found {sep} (header must be {example})", where=where)
+    if any(_looks_numeric(c) for c in header if c):
+        raise DataFileError(f"no header line: the first non-comment line must be the header {example}", where=where)
+    for j, c in enumerate(header, 1):
+        if c == "":
+            raise DataFileError(f"column {j} of the header has no name (a trailing comma?)", where=where)
+    dup = sorted({c for c in header if header.count(c) > 1})
+    if dup:
+        raise DataFileError(f"duplicated column(s): {', '.join(dup)}", where=where)
+    extra = [c for c in header if c not in allowed]
+    if extra:
+        hints = []
+        for c in extra:
+            close = difflib.get_close_matches(c.lower(), allowed, n=1, cutoff=0.6)
+            hints.append(f"'{c}' (column {header.index(c) + 1}" + (f"; did you mean '{close[0]}'?)" if close else ")"))
+        missing = [c for c in required if c not in header]
+        miss = f"; missing: {', '.join(missing)}" if missing else ""
+        raise DataFileError(f"unexpected column(s): {', '.join(hints)}{miss}; allowed: {', '.join(allowed)}",
+                            where=where)
+    missing = [c for c in required if c not in header]
+    if missing:
+        raise DataFileError(f"missing column(s): {', '.join(missing)} (header must be {example})", where=where)
+
+
+def _number(text: str, where: str, col: str, j: int) -> float:
+    label = f"column '{col}' (field {j})"
+    if text == "":
+        hint = " (fill in the scale reading)" if col == "reading_mm" else ""
+        raise DataFileError(f"{label}: empty cell{hint}", where=where)
+    try:
+        v = float(text)
+    except ValueError:
+        shown = text if len(text) <= 40 else text[:37] + "..."
+        raise DataFileError(f"{label}: {shown!r} is not a number", where=where) from None
+    if not math.isfinite(v):
+        raise DataFileError(f"{label}: {text} is not a finite number", where=where)
+    limit, unit = (ANGLE_LIMIT_DEG, "deg") if col.endswith("_deg") else (LENGTH_LIMIT_MM, "mm")
+    if col != "pose" and abs(v) > limit:
+        raise DataFileError(f"{label}: {v:g} is beyond the plausible range +-{limit:g} {unit}", where=where)
+    return v
+
+
+def _rows_to_records(rows, cols, src, int_cols=("pose",)):
+    values, lines = [], []
+    for lineno, cells in rows:
+        where = f"{src}:{lineno}"
+        if len(cells) != len(cols):
+            more = "" if len(cells) < len(cols) else f" (field {len(cols) + 1} = {cells[len(cols)]!r} is extra)"
+            raise DataFileError(f"{len(cells)} fields, expected {len(cols)} ({','.join(cols)}){more}", where=where)
+        rec = {}
+        for j, (c, cell) in enumerate(zip(cols, cells), 1):
+            rec[c] = _number(cell, where, c, j)
+            if c in int_cols and rec[c] != int(rec[c]):
+                raise DataFileError(f"column '{c}' (field {j}): {cell!r} is not a whole number", where=where)
+        values.append(rec)
+        lines.append(lineno)
+    return values, lines
+
+
+def _check_pose_numbers(values, lines, src, col_index):
+    """Poses numbered 0, 1, ... in file order; the first deviation is reported."""
+    first = {}
+    for k, rec in enumerate(values):
+        p = int(rec["pose"])
+        if p != k:
+            if p in first:
+                msg = f"pose {p} appears twice (lines {first[p]} and {lines[k]})"
+            else:
+                msg = f"expected {k}, got {p}" + (" (numbering starts at 0)" if k == 0 and p == 1 else "")
+            raise DataFileError(f"column 'pose' (field {col_index}): {msg}; poses are numbered 0, 1, ... in "
+                                "visiting order, one row each", where=f"{src}:{lines[k]}")
+        first[p] = lines[k]
+
+
+def _reject_constant(c):
+    raise ValueError(f"{c} is not allowed")
+
+
+def _load_json(text: str, src: str):
+    try:
+        return json.loads(text, parse_constant=_reject_constant)
+    except json.JSONDecodeError as exc:
+        raise DataFileError(f"not valid JSON: {exc.msg} (column {exc.colno})", where=f"{src}:{exc.lineno}") from None
+    except (ValueError, RecursionError) as exc:
+        raise DataFileError(f"not valid JSON: {exc}", where=src) from None
+
+
+def _json_line(text: str, key: str):
+    m = re.search(rf'"{re.escape(key)}"\s*:', text)
+    return text.count("\n", 0, m.start()) + 1 if m else None
