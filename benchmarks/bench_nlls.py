@@ -46,11 +46,12 @@ def main():
 
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.measurements import Measurements
-    from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+    from zerocal_sym.model.noise import NoiseModel, VirtualPlant
     from zerocal_sym.identify.nlls import get_problem, identify_nlls, residual_problem
     from zerocal_sym.report.plots import boundary_positions
     from zerocal_sym.model.robot import paper_robot
     from zerocal_sym.paper.scheme import paper_poses
+    from zerocal_sym.paper.tables import table2_errors
 
     robot = paper_robot()
     noise = NoiseModel.paper()

@@ -37,7 +37,9 @@ def main():
 
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-    from zerocal_sym.paper.reproduction import group_errors, reproduce, simulate_round
+    from zerocal_sym.identify.loop import simulate_round
+    from zerocal_sym.paper.reproduction import reproduce
+    from zerocal_sym.paper.tables import group_errors
     from zerocal_sym.model.robot import paper_robot
     from zerocal_sym.paper.scheme import identification_matrix, paper_poses
     from zerocal_sym.identify.tsvd import identify_tsvd, tsvd_solve

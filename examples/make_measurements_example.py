@@ -4,7 +4,7 @@ A simulated measurement round of the paper's robot (Table 1): Table 2 group 1
 (zero offsets 2 and -1 deg, geometric errors "set A", MAEMM (1, 0.5) mm, read
 in the paper's frame as ``zerocal simulate`` does -- ours mirrored about the
 x axis, so the true offsets in the robot's frame are (-2, +1) deg and the
-MAEMM (1, -0.5) mm; see ``zerocal_sym/paper.py``), the paper's six poses
+MAEMM (1, -0.5) mm; see ``zerocal_sym/paper/tables.py``), the paper's six poses
 (``scheme.paper_poses(robot, 3)``, visiting order as in SPEC.md), the paper's
 noise (Eqs. 34-35) and the random stream ``default_rng([2017, 1])``.  The
 readings are the same as those of
@@ -25,7 +25,7 @@ from zerocal_sym.paper import scheme
 from zerocal_sym.io.files import atomic_write_text
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-from zerocal_sym.paper.reproduction import group_errors
+from zerocal_sym.paper.tables import group_errors
 from zerocal_sym.model.robot import paper_robot
 
 HERE = Path(__file__).resolve().parent

@@ -9,7 +9,8 @@ from zerocal_sym.cli import main
 from zerocal_sym.io.measurements import write_measurements
 from zerocal_sym.io.results import load_result
 from zerocal_sym.model.measurements import Measurements
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+from zerocal_sym.paper.tables import table2_errors
 from zerocal_sym.paper.scheme import paper_poses
 
 

@@ -10,9 +10,10 @@ from zerocal_sym.identify.compare import METHODS, Progress, compare, format_comp
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.paper.tables import table2_errors
 
 
 def test_compare_all_methods_small(robot):

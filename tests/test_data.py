@@ -18,7 +18,8 @@ from zerocal_sym.model import kinematics
 from zerocal_sym.paper import scheme
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.model.measurements import Measurements
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+from zerocal_sym.paper.tables import table2_errors
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "measurements_example.csv"

@@ -5,9 +5,10 @@ import pytest
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.paper.tables import table2_errors
 
 
 @pytest.fixture(scope="module")

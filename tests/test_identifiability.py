@@ -6,8 +6,9 @@ from hypothesis import given, strategies as st
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify import identifiability as idf
 from zerocal_sym.model import kinematics as kin
-from zerocal_sym.model.noise import NoiseModel, table2_errors
+from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.paper.tables import table2_errors
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,10 @@ from zerocal_sym.identify import fisher
 from zerocal_sym.identify import identifiability as idf
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.identify.nlls import get_problem, identify_nlls, make_nlls_identifier, residual_problem
 from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.paper.tables import table2_errors
 
 PAPER4 = [0, 1, 10, 11]
 

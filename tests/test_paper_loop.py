@@ -5,9 +5,10 @@ import pytest
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-from zerocal_sym.paper.reproduction import (DEFAULT_MAEMM_PRIOR, PAPER_KAPPA_1, PAPER_KAPPA_M, PAPER_TABLE3, PAPER_TABLE4,
-                               PAPER_TABLE6, calibration_loop, group_errors, home_error, kappas,
-                               position_errors, reproduce, run_group, select_n, simulate_round)
+from zerocal_sym.identify.loop import calibration_loop, simulate_round
+from zerocal_sym.paper.reproduction import home_error, kappas, position_errors, reproduce, run_group, select_n
+from zerocal_sym.paper.tables import (DEFAULT_MAEMM_PRIOR, PAPER_KAPPA_1, PAPER_KAPPA_M, PAPER_TABLE3, PAPER_TABLE4,
+                                      PAPER_TABLE6, group_errors)
 from zerocal_sym.identify.result import IdentificationResult
 from zerocal_sym.paper.scheme import paper_poses
 

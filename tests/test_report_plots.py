@@ -9,9 +9,10 @@ import pytest
 from zerocal_sym.io import measurements as data
 from zerocal_sym.model import kinematics
 from zerocal_sym.report import plots as rp
+from zerocal_sym.identify.loop import calibration_loop
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-from zerocal_sym.paper.reproduction import calibration_loop, group_errors
+from zerocal_sym.paper.tables import group_errors
 from zerocal_sym.paper.scheme import paper_poses
 from zerocal_sym.identify.tsvd import identify_tsvd
 
@@ -144,7 +145,7 @@ def test_command_level_plot_sets(robot, tmp_path):
     # the plant's error before calibration at the 6 measurement poses is Table 4's 'before' (12.906 mm)
     assert d["fig12_group1.png"]["max_before_mm"] >= g1["dpmax_before_mm"] - 1e-9
     # compensation in Table 2's frame converted back to the robot's: the after-error matches reproduce's dp_max
-    six = rp.boundary_errors(robot, paper.group_errors(1), d["fig12_group1.png"]["compensation_deg"],
+    six = rp.boundary_errors(robot, group_errors(1), d["fig12_group1.png"]["compensation_deg"],
                              P=paper_poses(robot, 3))
     assert six["max_after_mm"] == pytest.approx(g1["dpmax_after_mm"], rel=1e-9)
     np.testing.assert_allclose(d["convergence_group1.png"]["compensation_deg"], g1["history"]["compensation_deg"])

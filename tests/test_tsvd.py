@@ -7,7 +7,7 @@ from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant, source_errors
-from zerocal_sym.paper.reproduction import simulate_round
+from zerocal_sym.identify.loop import simulate_round
 from zerocal_sym.paper.scheme import paper_poses
 from zerocal_sym.identify.tsvd import identify_tsvd, tsvd_solve
 

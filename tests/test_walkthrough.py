@@ -110,7 +110,7 @@ def test_walkthrough(capsys, tmp_path, monkeypatch):
     final = np.array(json.loads(Path(result).read_text())["zero_offsets_deg"])
     assert np.max(np.abs(final - truth)) < 0.25, (final, truth)
     # and it reduces the position error over the boundary (what a laser tracker would confirm)
-    from zerocal_sym.paper.reproduction import group_errors
+    from zerocal_sym.paper.tables import group_errors
 
     b = report_plots.boundary_errors(robot, group_errors(4), final)
     assert b["max_after_mm"] < 0.2 * b["max_before_mm"]

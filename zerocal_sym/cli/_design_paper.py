@@ -21,8 +21,8 @@ def run(args):
     from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
     from zerocal_sym.io.files import to_json
     from zerocal_sym.model.noise import NoiseModel
-    from zerocal_sym.paper.reproduction import (DEFAULT_MAEMM_PRIOR, MAEMM_PRIOR_READINGS, PAPER_KAPPA_1, PAPER_KAPPA_M,
-                                   kappas, select_n)
+    from zerocal_sym.paper.reproduction import kappas, select_n
+    from zerocal_sym.paper.tables import DEFAULT_MAEMM_PRIOR, MAEMM_PRIOR_READINGS, PAPER_KAPPA_1, PAPER_KAPPA_M
     from zerocal_sym.paper.scheme import identification_matrix, paper_poses
 
     robot = load_robot_arg(args)

@@ -31,10 +31,11 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.identify.loop import simulate_round
     from zerocal_sym.io.measurements import write_measurements
     from zerocal_sym.errors import PoseError, ZerocalError
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-    from zerocal_sym.paper.reproduction import group_errors, simulate_round
+    from zerocal_sym.paper.tables import group_errors
     from zerocal_sym.paper.scheme import paper_poses
 
     robot = load_robot_arg(args)

@@ -43,7 +43,8 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     """
     from zerocal_sym.identify import fisher
     from zerocal_sym.model.measurements import Measurements
-    from zerocal_sym.model.noise import VirtualPlant, table2_errors
+    from zerocal_sym.model.noise import VirtualPlant
+    from zerocal_sym.paper.tables import table2_errors
     from zerocal_sym.identify.nlls import identify_nlls
 
     if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:

@@ -99,29 +99,6 @@ def source_errors(zero_offsets_deg=(0.0, 0.0), geometric_mm=None, maemm_mm=(0.0,
     return err
 
 
-#: Geometric error "set A" of the paper's Table 2, mm.
-SET_A = {"e1x": 0.03, "e1y": -0.02, "e2x": -0.02, "e2y": 0.01,
-         "L1": 0.01, "L2": 0.02, "l1": -0.03, "l2": -0.02}
-#: Table 2: group -> (dtheta1 deg, dtheta2 deg, geometric scale of set A, MAEMM mm)
-TABLE2 = {
-    1: (2.0, -1.0, 1.0, (1.0, 0.5)),
-    2: (-1.0, 0.5, 1.0, (1.0, 0.5)),
-    3: (0.5, 0.25, 1.0, (1.0, 0.5)),
-    4: (2.0, -1.0, 0.1, (1.0, 0.5)),
-    5: (-1.0, 0.5, 0.1, (1.0, 0.5)),
-    6: (0.5, 0.25, 0.1, (1.0, 0.5)),
-}
-
-
-def table2_errors(group: int, geometric: bool = True) -> np.ndarray:
-    """Source errors of the paper's Table 2 group (1..6), ndarray shape (12,)."""
-    if group not in TABLE2:
-        raise ValueError(f"group must be 1..6, got {group}")
-    t1, t2, s, maemm = TABLE2[group]
-    geo = {k: s * v for k, v in SET_A.items()} if geometric else None
-    return source_errors((t1, t2), geo, maemm)
-
-
 class VirtualPlant:
     """A simulated robot with source errors and the measuring mechanism.
 

@@ -25,7 +25,8 @@ def fig8_data(robot, ns=range(3, 22), maemm_prior=None) -> dict:
     dict
         ``n`` (list of int), ``kappa_1``, ``kappa_m`` (lists of float), ``maemm_prior_mm``.
     """
-    from zerocal_sym.paper.reproduction import DEFAULT_MAEMM_PRIOR, kappas
+    from zerocal_sym.paper.reproduction import kappas
+    from zerocal_sym.paper.tables import DEFAULT_MAEMM_PRIOR
 
     prior = DEFAULT_MAEMM_PRIOR if maemm_prior is None else tuple(maemm_prior)
     ns = [int(n) for n in ns]

@@ -1,285 +1,30 @@
-"""The paper's calibration procedure and its simulation study (Sections 5-6).
+"""The paper's simulation study (Sections 5-6).
 
-* :func:`simulate_round` -- one identification round on a virtual plant;
-* :func:`calibration_loop` -- identify, compensate, re-measure, identify the
-  remainder until ``mu < mu0`` (Eq. 30-33), with a pluggable identifier;
 * :func:`select_n` -- the number of poses per boundary by the eps rule (Eq. 31);
 * :func:`run_group` / :func:`reproduce` -- Table 2's six groups through the
-  loop, with the paper's Tables 3-6 alongside.
+  loop (:func:`zerocal_sym.identify.loop.calibration_loop`), with the paper's
+  Tables 3-6 (:mod:`zerocal_sym.paper.tables`) alongside.
 
-Frame of Table 2 (see ``docs/reproduction.md``)
------------------------------------------------
-Read literally in our frame (``y`` from the base towards the workspace, angles
-counter-clockwise), Table 2's set values do not give the paper's ``dp0
-(before)`` (Table 3) and ``dp_max (before)`` (Table 4): differences up to
-0.19 mm.  Read in the frame mirrored about the ``x`` axis (``y -> -y``: the
-zero offsets, the ``e_iy`` and ``rMy`` change sign, everything else is
-unchanged) they reproduce Table 3 within 0.0015 mm and Table 4 within
-0.0004 mm (exact forward kinematics).  ``frame="paper"`` (the default) applies
-this reading; ``frame="literal"`` does not.  Offsets and MAEMM are *reported*
-in Table 2's frame so that they compare directly with the paper.
-
-Stopping rule
--------------
-``mu_j = sqrt(((c1_j - c1_{j-1})^2 + (c2_j - c2_{j-1})^2) / 2)`` with ``c_j``
-the compensation value (sum of the increments) after the ``j``-th
-identification, i.e. the RMS of the ``j``-th increment; defined from ``j = 2``.
+Table 2 is read in the frame described in :mod:`zerocal_sym.paper.tables`
+(``frame="paper"``, the default, or ``frame="literal"``).  Offsets and MAEMM
+are *reported* in Table 2's frame so that they compare directly with the paper.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
-from zerocal_sym.model.measurements import Measurements
-from zerocal_sym.errors import IdentificationError, PoseError, ZerocalError
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, table2_errors
+from zerocal_sym.errors import PoseError, ZerocalError
+# simulate_round: not used here, still reached as paper.simulate_round by identify/compare.py
+from zerocal_sym.identify.loop import calibration_loop, simulate_round  # noqa: F401
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.paper.scheme import condition_number, identification_matrix, paper_poses
+from zerocal_sym.paper.tables import (DEFAULT_MAEMM_PRIOR, PAPER_KAPPA_1, PAPER_KAPPA_M, PAPER_N, group_errors,
+                                      paper_table, to_table_frame)
 from zerocal_sym.identify.tsvd import identify_tsvd
-
-#: Sign of each source error (SOURCE_ERROR_NAMES order) under the mirror y -> -y.
-MIRROR_Y = np.array([-1, -1, 1, -1, 1, -1, 1, 1, 1, 1, 1, -1], dtype=float)
-FRAMES = ("paper", "literal")
-#: The paper's MAEMM prior (1, 0.5) mm read in the paper's (mirrored) frame, in our frame.
-DEFAULT_MAEMM_PRIOR = (1.0, -0.5)
-#: kappa_m readings of the paper's prior: label -> prior applied as lambda_k - rM (our frame).
-MAEMM_PRIOR_READINGS = {
-    "paper frame (y mirrored), lambda - rM": (1.0, -0.5),
-    "literal, lambda - rM": (1.0, 0.5),
-    "literal, lambda + rM": (-1.0, -0.5),
-    "paper frame, lambda + rM": (-1.0, 0.5),
-}
-
-# ---------------------------------------------------------------- paper's numbers
-PAPER_N = 3
-PAPER_KAPPA_1 = 475.34
-PAPER_KAPPA_M = 472.54
-#: Table 3: group -> compensation (deg), delta (deg), dp0 before, dp0 after (mm)
-PAPER_TABLE3 = {
-    1: ((2.033, -0.957), (0.033, 0.043), 10.933, 0.402),
-    2: ((-1.049, 0.463), (0.049, 0.037), 5.482, 0.423),
-    3: ((0.536, 0.297), (0.036, 0.047), 3.796, 0.434),
-    4: ((2.024, -0.978), (0.024, 0.022), 10.896, 0.228),
-    5: ((-1.025, 0.474), (0.025, 0.026), 5.5195, 0.256),
-    6: ((0.476, 0.225), (0.024, 0.025), 3.798, 0.239),
-}
-#: Table 4: group -> dp_max before, after (mm), over the six measurement poses
-PAPER_TABLE4 = {1: (12.906, 0.493), 2: (6.418, 0.531), 3: (4.672, 0.533),
-                4: (12.868, 0.279), 5: (6.455, 0.314), 6: (4.663, 0.293)}
-#: Table 5: group -> |delta rMx|, |delta rMy| (mm)
-PAPER_TABLE5 = {1: (0.069, 0.040), 2: (0.074, 0.045), 3: (0.071, 0.042),
-                4: (0.044, 0.022), 5: (0.051, 0.028), 6: (0.047, 0.024)}
-#: Table 6: group -> mean condition number
-PAPER_TABLE6 = {1: 472.47, 2: 472.49, 3: 472.49, 4: 472.50, 5: 472.51, 6: 472.50}
-
-
-def paper_table(group: int) -> dict:
-    """The paper's reported values for one group, with the JSON keys of :func:`run_group`."""
-    comp, delta, b, a = PAPER_TABLE3[group]
-    return {"group": group, "compensation_deg": list(comp), "delta_deg": list(delta),
-            "dp0_before_mm": b, "dp0_after_mm": a, "dpmax_before_mm": PAPER_TABLE4[group][0],
-            "dpmax_after_mm": PAPER_TABLE4[group][1], "delta_maemm_mm": list(PAPER_TABLE5[group]),
-            "kappa_mean": PAPER_TABLE6[group]}
-
-
-def group_errors(group: int, frame: str = "paper") -> np.ndarray:
-    """Source errors of Table 2's group in our frame, ndarray shape (12,).
-
-    Parameters
-    ----------
-    group : int
-        1..6.
-    frame : {"paper", "literal"}
-        ``paper``: Table 2 read in the frame mirrored about the x axis (module
-        docstring); ``literal``: read in our frame as printed.
-
-    Raises
-    ------
-    ZerocalError
-        Unknown group or frame.
-    """
-    if group not in PAPER_TABLE3:
-        raise ZerocalError(f"unknown group {group!r}: Table 2 has groups 1..6")
-    if frame not in FRAMES:
-        raise ZerocalError(f"unknown frame {frame!r} (known: {', '.join(FRAMES)})")
-    err = table2_errors(group)
-    return err * MIRROR_Y if frame == "paper" else err
-
-
-def to_table_frame(vec, frame: str, which: str):
-    """Offsets (``which="offsets"``) or MAEMM (``"maemm"``) from our frame to Table 2's."""
-    v = np.asarray(vec, float)
-    if frame == "literal":
-        return v.copy()
-    return v * (MIRROR_Y[[0, 1]] if which == "offsets" else MIRROR_Y[[10, 11]])
-
-
-# ---------------------------------------------------------------- simulation and loop
-def simulate_round(robot, plant, poses, compensation_rad=(0.0, 0.0), noise=None, rng=None) -> Measurements:
-    """One identification round: command the poses, read the scale.
-
-    Parameters
-    ----------
-    robot : Robot
-        Nominal robot (the controller's model).
-    plant : VirtualPlant
-    poses : ndarray, shape (K, 2)
-        Nominal target poses, mm, in visiting order.
-    compensation_rad : (2,)
-        Current compensation: commanded = IK(poses) - compensation.
-    noise : NoiseModel, optional
-    rng : numpy Generator or seed, optional
-
-    Returns
-    -------
-    Measurements
-        ``theta_cmd`` (K, 2) rad, ``readings`` (K,) mm, ``target`` = poses.
-    """
-    poses = np.atleast_2d(np.asarray(poses, float))
-    theta_cmd = kin.ik(robot, poses) - np.asarray(compensation_rad, float)
-    readings = plant.measure(theta_cmd, noise, rng)
-    return Measurements(theta_cmd=theta_cmd, readings=readings, target=poses.copy(),
-                        meta={}, source="<simulated>")
-
-
-@dataclass
-class IterationRecord:
-    """One identification of the loop.
-
-    Attributes
-    ----------
-    result : IdentificationResult
-    compensation_deg : ndarray, shape (2,)
-        Compensation value (sum of increments) after this identification, our frame.
-    increment_deg : ndarray, shape (2,)
-    mu_deg : float or None
-        Compensation accuracy (None at the first identification).
-    kappa : float
-        Condition number of G of this identification (NaN if the identifier does not report it).
-    maemm_mm : ndarray, shape (2,)
-    """
-
-    result: object
-    compensation_deg: np.ndarray
-    increment_deg: np.ndarray
-    mu_deg: float | None
-    kappa: float
-    maemm_mm: np.ndarray
-
-
-@dataclass
-class LoopResult:
-    """The whole history of a calibration loop.
-
-    Attributes
-    ----------
-    history : list of IterationRecord
-    compensation_deg : ndarray, shape (2,)
-        Compensation value when the loop stopped (at the first ``mu < mu0``
-        if it converged, else after the last identification), our frame.
-    maemm_mm : ndarray, shape (2,)
-        MAEMM estimate at the same identification.
-    converged : bool
-    iterations : int
-        Identifications up to and including the stopping one.
-    """
-
-    history: list = field(default_factory=list)
-    compensation_deg: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    maemm_mm: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    converged: bool = False
-    iterations: int = 0
-
-    @property
-    def kappas(self) -> np.ndarray:
-        """Condition number of each identification, shape (len(history),)."""
-        return np.array([h.kappa for h in self.history])
-
-    @property
-    def kappa_1(self) -> float:
-        return float(self.history[0].kappa)
-
-    @property
-    def kappa_mean(self) -> float:
-        """Mean condition number over all identifications run (paper's Table 6)."""
-        return float(np.mean(self.kappas))
-
-    @property
-    def kappa_m(self) -> float:
-        """Mean condition number over the identifications after the first."""
-        k = self.kappas[1:]
-        return float(np.mean(k)) if k.size else float("nan")
-
-
-def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rng=None, mu0_deg=0.1,
-                     max_iter=20, maemm_prior=None, run_all=False) -> LoopResult:
-    """The paper's iterative identification and compensation (Eq. 30-33).
-
-    Each round commands ``IK(poses) - compensation``, measures, and calls
-    ``identify(robot, meas, prior)`` with ``prior`` the 12-vector of the
-    current total estimates (offsets = compensation, MAEMM = previous
-    estimate; from the 2nd identification on this corrects the nominal
-    measuring-mechanism vector, Eq. 30).  The identifier returns totals; the
-    new compensation is its offset estimate (= the sum of the increments).
-
-    Parameters
-    ----------
-    robot : Robot
-    plant : VirtualPlant
-    poses : ndarray, shape (K, 2)
-    identify : callable
-        ``identify(robot, meas, prior) -> IdentificationResult`` (TSVD by default;
-        an Ipopt identifier plugs in the same way).
-    noise : NoiseModel, optional
-    rng : numpy Generator or seed, optional
-    mu0_deg : float
-        Threshold of the compensation accuracy mu.
-    max_iter : int
-        Maximum number of identifications.
-    maemm_prior : (2,), optional
-        MAEMM prior of the first identification (default zero, as the paper).
-    run_all : bool
-        Continue to ``max_iter`` after convergence (the paper's robustness
-        study, Fig. 9); the reported state is still the one at convergence.
-
-    Returns
-    -------
-    LoopResult
-    """
-    if max_iter < 1:
-        raise ValueError("max_iter must be >= 1")
-    rng = np.random.default_rng(rng)
-    prior = np.zeros(12)
-    if maemm_prior is not None:
-        prior[10:12] = np.asarray(maemm_prior, float)
-    out = LoopResult()
-    comp = np.zeros(2)
-    for j in range(1, max_iter + 1):
-        meas = simulate_round(robot, plant, poses, comp, noise, rng)
-        res = identify(robot, meas, prior.copy())
-        if not getattr(res, "success", True):
-            raise IdentificationError(f"identification {j} failed: {res.status}")
-        new = np.array([res.value("theta1"), res.value("theta2")])
-        maemm = np.array([res.value("rMx", prior[10]), res.value("rMy", prior[11])])
-        inc = new - comp
-        mu = None if j == 1 else float(np.degrees(np.sqrt(np.mean(inc**2))))
-        kappa = float(res.info.get("kappa", np.nan)) if isinstance(res.info, dict) else float("nan")
-        if not np.isfinite(kappa):
-            P = kin.fk(robot, meas.theta_cmd + prior[:2])
-            kappa = condition_number(identification_matrix(robot, P, prior[10:12])[0])
-        out.history.append(IterationRecord(res, np.degrees(new), np.degrees(inc), mu, kappa, maemm.copy()))
-        comp = new
-        prior[:2] = new
-        prior[10:12] = maemm
-        if not out.converged:
-            out.compensation_deg, out.maemm_mm, out.iterations = np.degrees(new), maemm.copy(), j
-            if mu is not None and mu < mu0_deg:
-                out.converged = True
-                if not run_all:
-                    break
-    return out
 
 
 # ---------------------------------------------------------------- evaluation

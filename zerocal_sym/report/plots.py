@@ -371,7 +371,7 @@ def reproduce_plots(out_dir, rep: dict, robot=None, K: int = 42) -> dict:
     """
     from pathlib import Path
 
-    from zerocal_sym.paper.reproduction import group_errors, to_table_frame
+    from zerocal_sym.paper.tables import group_errors, to_table_frame
     from zerocal_sym.model.robot import paper_robot
 
     robot = robot or paper_robot()
