@@ -42,11 +42,16 @@ HERE = Path(__file__).resolve().parent
 GENERATED_DIR = HERE.parent / "zerocal_sym" / "generated"
 
 
+def _relative(path) -> str:
+    """``derivations/...`` path of a derivation source."""
+    return Path(path).resolve().relative_to(HERE.parent).as_posix()
+
+
 def input_hash(sources) -> str:
     """SHA-256 (first 16 hex digits) over the derivation sources."""
     h = hashlib.sha256()
-    for path in sorted(sources):
-        h.update(Path(path).name.encode())
+    for path in sorted(sources, key=_relative):
+        h.update(_relative(path).encode())
         h.update(Path(path).read_bytes())
     return h.hexdigest()[:16]
 
@@ -74,7 +79,7 @@ def emit_function(fname: str, spec: dict, printer) -> str:
         for k, s in enumerate(syms):
             if s in used:
                 lines.append(f"    {printer.doprint(s)} = {argname}[{k}]")
-    repl, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"), optimizations="basic")
+    repl, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"))
     for sym, expr in repl:
         lines.append(f"    {printer.doprint(sym)} = {printer.doprint(expr)}")
     pos = 0
@@ -89,7 +94,10 @@ def emit_function(fname: str, spec: dict, printer) -> str:
 def render(mech, sources) -> str:
     """The full generated module for ``mech`` as a string."""
     printer = CasadiPrinter({"fully_qualified_modules": True, "inline": True})
-    src_names = ", ".join(f"derivations/{Path(p).name}" for p in sorted(sources))
+    src_names = ", ".join(_relative(p) for p in sorted(sources, key=_relative))
+    geo_units = {str(s): mech.geometry_units.get(str(s), "mm") for s in mech.geometry}
+    source_errors = [(e.name, e.role, e.unit, str(e.target), None if e.lever is None else str(e.lever))
+                     for e in mech.source_errors]
     out = [
         f'"""Generated CasADi builders for the mechanism ``{mech.name}``.',
         "",
@@ -101,10 +109,25 @@ def render(mech, sources) -> str:
         "import casadi as ca",
         "",
         f"NAME = {mech.name!r}",
+        f"DESCRIPTION = {mech.description!r}",
         f"POSE_NAMES = {[str(s) for s in mech.pose]!r}",
         f"JOINT_NAMES = {[str(s) for s in mech.joints]!r}",
         f"GEOMETRY_NAMES = {[str(s) for s in mech.geometry]!r}",
-        f"SOURCE_ERROR_NAMES = {[n for n, _ in mech.source_errors]!r}",
+        f"GEOMETRY_UNITS = {geo_units!r}",
+        "#: (name, role, unit, target, lever arm) of each source error, in vector order",
+        "SOURCE_ERRORS = [",
+        *[f"    {row!r}," for row in source_errors],
+        "]",
+        f"SOURCE_ERROR_NAMES = {[e.name for e in mech.source_errors]!r}",
+        f"HOME_JOINTS = {[float(v) for v in mech.home_joints]!r}",
+        f"MEASURING_BASE = {[str(s) for s in mech.base_point]!r}",
+        f"MEASURING_OFFSET = {[str(s) for s in mech.platform_offset]!r}",
+        f"GAUGE_NAMES = {list(mech.gauge)!r}",
+        f"WORKSPACE = {mech.workspace!r}",
+        f"ALIASES = {mech.aliases!r}",
+        f"DEFAULTS = {mech.defaults!r}",
+        f"PARAM_SETS = {mech.param_sets!r}",
+        f"POSITIVE = {list(mech.positive)!r}",
         "FUNCTION_SIGNATURES = {",
     ]
     for fname, spec in mech.outputs.items():
@@ -135,7 +158,11 @@ def render(mech, sources) -> str:
     return "\n".join(out)
 
 
-MECHANISMS = {"planar_2dof": "derivations.planar_2dof"}
+#: Every mechanism: generated module name -> its derivation module.
+MECHANISMS = {
+    "planar_2dof": "derivations.mechanisms.planar_2dof",
+    "delta_rotary": "derivations.mechanisms.delta_rotary",
+}
 
 
 def generate(out_dir: Path | None = None, check_forms: bool = True) -> dict:

@@ -1,14 +1,21 @@
 """Numeric kinematics on top of the generated CasADi functions.
 
-Everything here is batched over K poses: poses are ``ndarray, shape (K, 2)``
-in mm, joint angles ``ndarray, shape (K, 2)`` in radians.  Degrees appear only
-at the user-facing edges (CLI, data files, reports).
+Everything here is batched over K poses and works for every mechanism: poses
+are ``ndarray, shape (K, n)`` in mm, joint angles ``ndarray, shape (K, m)`` in
+radians, source errors ``ndarray, shape (q,)`` in the mechanism's order (rad,
+mm; built by name with :class:`~zerocal_sym.model.source_errors.SourceErrors`).
+Degrees appear only at the user-facing edges (CLI, data files, reports).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from zerocal_sym.errors import PoseError
+
+
+def fmt_pose(p) -> str:
+    """``(x, y[, z])`` with ``%g`` numbers, for messages."""
+    return "(" + ", ".join(f"{v:g}" for v in p) + ")"
 
 
 def _cols(a, n):
@@ -46,24 +53,24 @@ def ik(robot, P, check: bool = True):
     Parameters
     ----------
     robot : Robot
-    P : ndarray, shape (K, 2)
+    P : ndarray, shape (K, n)
         Platform positions, mm.
     check : bool
         Raise :class:`PoseError` naming the first unreachable pose.
 
     Returns
     -------
-    ndarray, shape (K, 2)
+    ndarray, shape (K, m)
         Joint angles, rad.
     """
-    P = _cols(P, 2)
+    P = _cols(P, robot.n)
     theta, ratio = _call(robot, "ik", P, robot.geometry)
     theta = theta[:, :, 0]
     if check:
         bad = np.flatnonzero(~np.all(np.abs(ratio[:, :, 0]) <= 1.0, axis=1) | ~np.all(np.isfinite(theta), axis=1))
         if bad.size:
             k = int(bad[0])
-            raise PoseError(f"pose ({P[k, 0]:g}, {P[k, 1]:g}) mm is unreachable (a limb cannot close)",
+            raise PoseError(f"pose {fmt_pose(P[k])} mm is unreachable (a limb cannot close)",
                             where=f"pose {k}")
     return theta
 
@@ -73,35 +80,35 @@ def fk(robot, theta):
 
     Parameters
     ----------
-    theta : ndarray, shape (K, 2)
+    theta : ndarray, shape (K, m)
         Joint angles, rad.
 
     Returns
     -------
-    ndarray, shape (K, 2)
-        Positions, mm; NaN where the distal circles do not meet.
+    ndarray, shape (K, n)
+        Positions, mm; NaN where the limbs do not close.
     """
-    return _call(robot, "fk", _cols(theta, 2), robot.geometry)[0][:, :, 0]
+    return _call(robot, "fk", _cols(theta, robot.m), robot.geometry)[0][:, :, 0]
 
 
 def _at_pose(robot, fname, P, theta=None):
-    P = _cols(P, 2)
-    theta = ik(robot, P) if theta is None else _cols(theta, 2)
+    P = _cols(P, robot.n)
+    theta = ik(robot, P) if theta is None else _cols(theta, robot.m)
     return _call(robot, fname, P, theta, robot.geometry)[0]
 
 
 def error_jacobian(robot, P, theta=None):
-    """Paper Eq. (13): ``dP = J dq`` with ``dq = (L1 dth1, L2 dth2)``.
+    """Paper Eq. (13): ``dP = J dq`` with ``dq = (lever_i dth_i)`` (``L_i dth_i``).
 
     Returns
     -------
-    ndarray, shape (K, 2, 2)
+    ndarray, shape (K, n, m)
     """
     return _at_pose(robot, "error_jacobian", P, theta)
 
 
 def error_jacobian_full(robot, P, theta=None):
-    """Paper Eq. (12): ``dP = J' dq'``, ``dq' = (L1 dth1, de1x, de1y, dL1, dl1, L2 dth2, ...)``.
+    """Paper Eq. (12) (planar robot only): ``dP = J' dq'``, ``dq' = (L1 dth1, de1x, de1y, dL1, dl1, L2 dth2, ...)``.
 
     Returns
     -------
@@ -111,25 +118,25 @@ def error_jacobian_full(robot, P, theta=None):
 
 
 def pose_error_jacobian(robot, P, theta=None):
-    """dP / d(source errors), in the mechanism's source-error order without rM.
+    """dP / d(robot source errors): every source error but the measuring ones, in order.
 
     Returns
     -------
-    ndarray, shape (K, 2, 10)
-        Columns: theta1 theta2 (per rad), e1x e1y e2x e2y L1 L2 l1 l2 (per mm).
+    ndarray, shape (K, n, r)
+        Per rad for angles, per mm for lengths.
     """
     return _at_pose(robot, "pose_error_jacobian", P, theta)
 
 
 def transmission(robot, P, theta=None):
-    """Sines of the transmission angles ``(u_1, w_1)``, ``(u_2, w_2)`` and of ``(w_1, w_2)``.
+    """The mechanism's singularity indicators (sines of transmission angles, ...).
 
-    A zero is a singular configuration (serial for the first two, parallel for
-    the third).
+    A zero is a singular configuration (planar: ``(u_i, w_i)`` serial,
+    ``(w_1, w_2)`` parallel; Delta: per limb and ``det[w_1; w_2; w_3]``).
 
     Returns
     -------
-    ndarray, shape (K, 3)
+    ndarray, shape (K, s)
     """
     return _at_pose(robot, "transmission", P, theta)[:, :, 0]
 
@@ -140,9 +147,9 @@ def measuring_vector(robot, P):
     Returns
     -------
     lam : ndarray, shape (K,)
-    lam_hat : ndarray, shape (K, 2)
+    lam_hat : ndarray, shape (K, n)
     """
-    lam, lam_hat = _call(robot, "measuring", _cols(P, 2), robot.geometry)
+    lam, lam_hat = _call(robot, "measuring", _cols(P, robot.n), robot.geometry)
     return lam[:, 0, 0], lam_hat[:, :, 0]
 
 
@@ -151,7 +158,7 @@ def g_rows(robot, P, theta=None):
 
     Returns
     -------
-    ndarray, shape (K, 4)
+    ndarray, shape (K, m + n)
     """
     return _at_pose(robot, "g_row", P, theta)[:, 0, :]
 
@@ -161,18 +168,23 @@ def distance(robot, theta_cmd, err=None):
 
     Parameters
     ----------
-    theta_cmd : ndarray, shape (K, 2)
+    theta_cmd : ndarray, shape (K, m)
         Commanded joint angles, rad.
-    err : ndarray, shape (12,) or (K, 12), optional
-        Source errors (rad, mm) in ``robot.mechanism.source_error_names`` order.
+    err : ndarray, shape (q,) or (K, q), optional
+        Source errors (rad, mm) in the mechanism's order.
 
     Returns
     -------
     ndarray, shape (K,)
     """
-    theta_cmd = _cols(theta_cmd, 2)
-    err = np.zeros(len(robot.mechanism.source_error_names)) if err is None else np.asarray(err, float)
+    theta_cmd = _cols(theta_cmd, robot.m)
+    err = robot.errors.zeros() if err is None else robot.errors.check_vector(err)
     return _call(robot, "distance", theta_cmd, robot.geometry, err)[0][:, 0, 0]
+
+
+def gauge(robot) -> np.ndarray:
+    """The mechanism's gauge motions at the robot's geometry, shape (q, z) (columns ``gauge_names``)."""
+    return np.array(robot.mechanism["gauge"](robot.geometry).full()).reshape(len(robot.errors), -1)
 
 
 def check_poses(robot, P, margin=None, in_workspace=False, tol=1e-6):
@@ -183,20 +195,18 @@ def check_poses(robot, P, margin=None, in_workspace=False, tol=1e-6):
 
     Returns
     -------
-    theta : ndarray, shape (K, 2)
+    theta : ndarray, shape (K, m)
     """
-    P = _cols(P, 2)
+    P = _cols(P, robot.n)
     if not np.all(np.isfinite(P)):
         k = int(np.flatnonzero(~np.all(np.isfinite(P), axis=1))[0])
         raise PoseError("pose is not finite", where=f"pose {k}")
     if in_workspace:
-        lo, hi = robot.workspace_bounds()
-        out = np.flatnonzero(np.any((P < lo - tol) | (P > hi + tol), axis=1))
+        out = np.flatnonzero(~robot.workspace.contains(P, tol))
         if out.size:
             k = int(out[0])
-            raise PoseError(
-                f"pose ({P[k, 0]:g}, {P[k, 1]:g}) mm is outside the workspace "
-                f"x in [{lo[0]:g}, {hi[0]:g}], y in [{lo[1]:g}, {hi[1]:g}]", where=f"pose {k}")
+            raise PoseError(f"pose {fmt_pose(P[k])} mm is outside the workspace {robot.workspace.describe()}",
+                            where=f"pose {k}")
     theta = ik(robot, P)
     margin = robot.singularity_margin if margin is None else margin
     s = np.abs(transmission(robot, P, theta))
@@ -204,7 +214,7 @@ def check_poses(robot, P, margin=None, in_workspace=False, tol=1e-6):
     if bad.size:
         k = int(bad[0])
         raise PoseError(
-            f"pose ({P[k, 0]:g}, {P[k, 1]:g}) mm is too close to a singular configuration "
+            f"pose {fmt_pose(P[k])} mm is too close to a singular configuration "
             f"(min |sin transmission angle| = {np.min(s[k]):.3g} < margin {margin:g})", where=f"pose {k}")
     return theta
 
@@ -214,20 +224,20 @@ def distance_jacobians(robot, theta_cmd, err=None):
 
     Parameters
     ----------
-    theta_cmd : ndarray, shape (K, 2)
+    theta_cmd : ndarray, shape (K, m)
         Commanded joint angles, rad.
-    err : ndarray, shape (12,) or (K, 12), optional
+    err : ndarray, shape (q,) or (K, q), optional
         Source errors at which to linearise (default zero).
 
     Returns
     -------
     rho : ndarray, shape (K,)
-    drho_derr : ndarray, shape (K, 12)
-        Per rad for the joint offsets, per mm for the rest.
-    drho_dtheta : ndarray, shape (K, 2)
+    drho_derr : ndarray, shape (K, q)
+        Per rad for angles, per mm for lengths.
+    drho_dtheta : ndarray, shape (K, m)
         Per rad.
     """
-    theta_cmd = _cols(theta_cmd, 2)
-    err = np.zeros(len(robot.mechanism.source_error_names)) if err is None else np.asarray(err, float)
+    theta_cmd = _cols(theta_cmd, robot.m)
+    err = robot.errors.zeros() if err is None else robot.errors.check_vector(err)
     rho, de, dt = _call(robot, "distance_jacobians", theta_cmd, robot.geometry, err)
     return rho[:, 0, 0], de[:, 0, :], dt[:, 0, :]

@@ -20,12 +20,6 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 
-SOURCE_ERROR_NAMES = ("theta1", "theta2", "e1x", "e1y", "e2x", "e2y",
-                      "L1", "L2", "l1", "l2", "rMx", "rMy")
-#: indices of the zero offsets and of the MAEMM in the source-error vector
-ZERO_OFFSETS = (0, 1)
-MAEMM = (10, 11)
-GEOMETRIC = tuple(range(2, 10))
 
 
 def paper_sigma_scale_mm(l0_mm: float = 350.0) -> float:
@@ -72,33 +66,6 @@ class NoiseModel:
         return self.sigma_scale_mm == 0 and self.sigma_servo_rad == 0
 
 
-def source_errors(zero_offsets_deg=(0.0, 0.0), geometric_mm=None, maemm_mm=(0.0, 0.0)):
-    """Assemble a source-error vector.
-
-    Parameters
-    ----------
-    zero_offsets_deg : (2,)
-    geometric_mm : dict or sequence of 8, optional
-        ``e1x e1y e2x e2y L1 L2 l1 l2``.
-    maemm_mm : (2,)
-
-    Returns
-    -------
-    ndarray, shape (12,)
-        rad for the offsets, mm otherwise, in :data:`SOURCE_ERROR_NAMES` order.
-    """
-    err = np.zeros(12)
-    err[list(ZERO_OFFSETS)] = np.radians(np.asarray(zero_offsets_deg, float))
-    if geometric_mm is not None:
-        if isinstance(geometric_mm, dict):
-            for k, v in geometric_mm.items():
-                err[SOURCE_ERROR_NAMES.index(k)] = v
-        else:
-            err[list(GEOMETRIC)] = np.asarray(geometric_mm, float)
-    err[list(MAEMM)] = np.asarray(maemm_mm, float)
-    return err
-
-
 class VirtualPlant:
     """A simulated robot with source errors and the measuring mechanism.
 
@@ -106,23 +73,25 @@ class VirtualPlant:
     ----------
     robot : Robot
         Nominal robot (what the controller believes).
-    err : ndarray, shape (12,)
-        True source errors (rad, mm).
+    err : ndarray, shape (q,) or dict
+        True source errors (rad, mm), a vector in the mechanism's order or
+        ``{name: value}`` (internal units).
     """
 
     def __init__(self, robot, err):
         self.robot = robot
-        self.err = np.asarray(err, float)
+        self.err = robot.errors.vector(err) if isinstance(err, dict) else robot.errors.check_vector(err).copy()
 
     def actual_pose(self, theta_cmd):
         """Where the platform actually is for commanded joints (no noise).
 
         Returns
         -------
-        ndarray, shape (K, 2)
+        ndarray, shape (K, n)
         """
-        actual = replace(self.robot, geometry=self.robot.geometry + _geometry_error(self.robot, self.err))
-        return kin.fk(actual, np.asarray(theta_cmd) + self.err[list(ZERO_OFFSETS)])
+        errors = self.robot.errors
+        actual = replace(self.robot, geometry=self.robot.geometry + geometry_error(self.robot, self.err))
+        return kin.fk(actual, np.asarray(theta_cmd) + errors.take(self.err, errors.zero_offsets))
 
     def lengths(self, theta_cmd, noise: NoiseModel | None = None, rng=None):
         """Actual measuring-mechanism lengths, servo error included.
@@ -142,7 +111,7 @@ class VirtualPlant:
 
         Parameters
         ----------
-        theta_cmd : ndarray, shape (K, 2)
+        theta_cmd : ndarray, shape (K, m)
             Commanded joint angles, rad.
         noise : NoiseModel, optional
         rng : numpy Generator or seed, optional
@@ -160,13 +129,15 @@ class VirtualPlant:
         return np.concatenate([[0.0], s])
 
 
-def _geometry_error(robot, err):
-    """Map the robot part of the source errors onto the geometry vector."""
+def geometry_error(robot, err) -> np.ndarray:
+    """The geometry and measuring part of the source errors on the geometry vector, shape (G,).
+
+    A measuring-mechanism error is carried on the base point ``c`` (it enters
+    the distance only through ``c + d``).
+    """
     names = robot.mechanism.geometry_names
     dg = np.zeros(len(names))
-    for k, n in enumerate(SOURCE_ERROR_NAMES):
-        if n in names:
-            dg[names.index(n)] += err[k]
-    dg[names.index("cx")] += err[MAEMM[0]]
-    dg[names.index("cy")] += err[MAEMM[1]]
+    for e, v in zip(robot.errors, robot.errors.check_vector(err)):
+        if e.role != "zero_offset":
+            dg[names.index(e.target)] += v
     return dg

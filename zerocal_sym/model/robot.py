@@ -1,23 +1,35 @@
-"""Robot geometry: the paper's Table 1 built in, other robots from TOML files.
+"""Robots: a mechanism, its nominal geometry and its workspace; robot files.
 
-A robot file (mm, degrees) has the keys of Table 1::
+A robot file (TOML, mm and degrees) names its mechanism and gives the
+geometry and the workspace, in tables or (the paper's flat files) at the top::
 
-    ex = 80      # A1 = (ex, ey), A2 = (-ex, ey)
-    ey = 0
-    L = 375      # proximal links (or L1, L2)
-    l = 825      # distal links   (or l1, l2)
-    H = 632      # workspace: x in [-b/2, b/2], y in [H, H + h]
-    b = 480
-    h = 150
-    cx = 0       # O -> O1, base joint of the measuring mechanism
-    cy = 79
-    dx = 0       # O2 -> P, platform joint of the measuring mechanism
-    dy = 51
+    name = "my delta"
+    mechanism = "delta_rotary"        # default "planar_2dof"
+    singularity_margin = 0.2          # optional
+    home = [0, 0, 0]                  # optional, deg (default: the mechanism's)
 
-and optionally ``name``, ``mechanism = "planar_2dof"``, ``units = "mm"`` and
-``singularity_margin`` (default 0.2: every ``|sin|`` of a transmission angle in
-the workspace must be at least this, i.e. angles kept >= 11.5 deg from a
-singular configuration).
+    [geometry]                        # the mechanism's geometry names, or aliases
+    R = 200                           # alias: R1 = R2 = R3 = 200
+    L = 350
+    l = 800
+    r = 50
+    cx = 0
+    ...
+
+    [workspace]                       # the mechanism's workspace shape
+    rw = 200
+    H = 700
+    h = 200
+
+An alias (``L`` for ``L1 = L2``, the planar ``ex`` for ``e1x = ex, e2x = -ex``)
+sets several entries; an entry named explicitly wins over its alias (``L = 375``
+with ``L2 = 380``).  Entries the mechanism gives defaults for may be left out
+(the Delta's azimuths 0/120/240 deg).  Angles (the Delta's ``phi_i``) are
+given in degrees.
+
+The paper's flat files (``ex = 80``, ``L = 375``, ``H = 632``, ...) keep
+working with the same :attr:`Robot.sha256`.  The paper's robot (Table 1) is
+built in (:func:`paper_robot`); ``examples/`` holds a file for each mechanism.
 """
 from __future__ import annotations
 
@@ -31,82 +43,103 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import RobotFileError
-from zerocal_sym.model.mechanism import get_mechanism
+from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, REGISTRY, get_mechanism
+from zerocal_sym.model.workspace import SHAPES
 
 #: Paper Table 1 (with the OCR-dropped ``ey = 0`` restored), mm.
 PAPER_TABLE1 = dict(ex=80.0, ey=0.0, L=375.0, l=825.0, H=632.0, b=480.0, h=150.0,
                     cx=0.0, cy=79.0, dx=0.0, dy=51.0)
 
 DEFAULT_SINGULARITY_MARGIN = 0.2
-REQUIRED = ("ex", "ey", "H", "b", "h", "cx", "cy", "dx", "dy")
-OPTIONAL = ("L", "l", "L1", "L2", "l1", "l2", "name", "mechanism", "units", "singularity_margin")
+TOP_KEYS = ("name", "mechanism", "units", "singularity_margin", "home")
+TABLES = ("geometry", "workspace")
 
 
 @dataclass(frozen=True)
 class Robot:
-    """A robot of the paper's kind with its workspace.
+    """A robot: a mechanism with its nominal geometry and its workspace.
 
     Attributes
     ----------
-    geometry : ndarray, shape (12,)
-        ``e1x e1y e2x e2y L1 L2 l1 l2 cx cy dx dy`` (mm).
-    H, b, h : float
-        Workspace rectangle ``x in [-b/2, b/2]``, ``y in [H, H + h]`` (mm).
+    geometry : ndarray, shape (G,)
+        In the mechanism's ``geometry_names`` order (mm; rad for angles).
+    workspace : Rectangle or Cylinder
+    home : ndarray, shape (m,) or None
+        Home joints (rad) if the file overrides the mechanism's.
     """
 
     geometry: np.ndarray
-    H: float
-    b: float
-    h: float
+    workspace: object
     name: str = "paper"
-    mechanism_name: str = "planar_2dof"
+    mechanism_name: str = DEFAULT_MECHANISM
     source: str = "built-in (Mei et al. 2017, Table 1)"
     singularity_margin: float = DEFAULT_SINGULARITY_MARGIN
+    home: np.ndarray | None = None
     keys: dict = field(default_factory=dict, compare=False)
 
     @property
     def mechanism(self):
         return get_mechanism(self.mechanism_name)
 
-    def param(self, name: str) -> float:
-        """A geometric parameter by name (``L1``, ``cy``, ...)."""
-        return float(self.geometry[self.mechanism.geometry_names.index(name)])
+    @property
+    def errors(self):
+        """The mechanism's :class:`~zerocal_sym.model.source_errors.SourceErrors`."""
+        return self.mechanism.errors
 
     @property
-    def link_lengths(self):
-        """``(L1, L2)``, mm."""
-        return np.array([self.param("L1"), self.param("L2")])
+    def n(self) -> int:
+        return self.mechanism.n
+
+    @property
+    def m(self) -> int:
+        return self.mechanism.m
+
+    def param(self, name: str) -> float:
+        """A geometric parameter by name (``L1``, ``cy``, ...), internal units."""
+        return float(self.geometry[self.mechanism.geometry_names.index(name)])
+
+    def params(self, names) -> np.ndarray:
+        return np.array([self.param(n) for n in names])
+
+    def error_scale(self, names) -> np.ndarray:
+        """mm per unit of each source error: lever arm for angles, 1 for lengths, shape (p,)."""
+        return self.errors.scale(names, self.param)
+
+    @property
+    def measuring_point(self) -> np.ndarray:
+        """``c + d`` (mm), shape (n,)."""
+        mech = self.mechanism
+        return self.params(mech.measuring_base) + self.params(mech.measuring_offset)
 
     def workspace_bounds(self):
-        """``(lo, hi)``: ndarray, shape (2,) each."""
-        return np.array([-self.b / 2, self.H]), np.array([self.b / 2, self.H + self.h])
+        """Bounding box of the workspace, ``(lo, hi)`` ndarray shape (n,) each."""
+        return self.workspace.bounds()
 
-    def workspace_corners(self):
-        """Dict corner label -> (x, y) in mm."""
-        x0, x1, y0, y1 = -self.b / 2, self.b / 2, self.H, self.H + self.h
-        return {"(-b/2, H)": (x0, y0), "(b/2, H)": (x1, y0),
-                "(-b/2, H+h)": (x0, y1), "(b/2, H+h)": (x1, y1)}
+    def workspace_corners(self) -> dict:
+        return self.workspace.corners()
 
-    def workspace_grid(self, nx=25, ny=9):
-        """Grid over the workspace rectangle, ndarray shape (nx*ny, 2)."""
-        lo, hi = self.workspace_bounds()
-        X, Y = np.meshgrid(np.linspace(lo[0], hi[0], nx), np.linspace(lo[1], hi[1], ny))
-        return np.column_stack([X.ravel(), Y.ravel()])
+    def workspace_grid(self, *args):
+        return self.workspace.grid(*args)
 
-    def home_joints(self):
-        """Home: ``theta1 = 0``, ``theta2 = pi`` (rad), ndarray shape (2,)."""
-        return np.array([0.0, np.pi])
+    def home_joints(self) -> np.ndarray:
+        """Home joints (rad), shape (m,)."""
+        return self.mechanism.home_joints.copy() if self.home is None else np.array(self.home, float)
 
-    def home_pose(self):
-        """Home position P0, mm, ndarray shape (2,)."""
+    def home_pose(self) -> np.ndarray:
+        """Home position P0, mm, shape (n,)."""
         from zerocal_sym.model.kinematics import fk
 
         return fk(self, self.home_joints()[None, :])[0]
 
-    def to_dict(self):
-        d = {k: float(v) for k, v in zip(self.mechanism.geometry_names, self.geometry)}
-        d.update(H=self.H, b=self.b, h=self.h, mechanism=self.mechanism_name,
-                 singularity_margin=self.singularity_margin)
+    def to_dict(self) -> dict:
+        """Geometry (file units: mm, deg), workspace, mechanism and margin: what :attr:`sha256` hashes."""
+        units = self.mechanism.geometry_units
+        d = {k: float(np.degrees(v)) if units.get(k) == "rad" else float(v)
+             for k, v in zip(self.mechanism.geometry_names, self.geometry)}
+        d.update(self.workspace.to_dict())
+        d.update(mechanism=self.mechanism_name, singularity_margin=self.singularity_margin)
+        if self.home is not None:
+            d["home_deg"] = np.degrees(self.home).tolist()
         return d
 
     @property
@@ -115,26 +148,52 @@ class Robot:
         return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()
 
 
-def _from_keys(keys: dict, name: str, source: str, where) -> Robot:
-    def get(k):
-        return float(keys[k])
+def _geometry(mech, values: dict, where) -> np.ndarray:
+    """Geometry vector from explicit entries, aliases and defaults (file units)."""
+    out, missing = [], []
+    for name in mech.geometry_names:
+        if name in values:
+            v = values[name]
+        else:
+            v = None
+            for alias, parts in mech.aliases.items():
+                if name in parts and alias in values:
+                    v = parts[name] * values[alias]
+            if v is None:
+                v = mech.defaults.get(name)
+        if v is None:
+            alias = [a for a, parts in mech.aliases.items() if name in parts]
+            missing.append(f"{alias[0]} (or {' and '.join(mech.aliases[alias[0]])})" if alias else name)
+            continue
+        out.append(np.radians(v) if mech.geometry_units.get(name) == "rad" else float(v))
+    if missing:
+        raise RobotFileError(f"missing key(s): {', '.join(dict.fromkeys(missing))}", where=where(None))
+    return np.array(out, float)
 
-    L1 = get("L1") if "L1" in keys else get("L")
-    L2 = get("L2") if "L2" in keys else get("L")
-    l1 = get("l1") if "l1" in keys else get("l")
-    l2 = get("l2") if "l2" in keys else get("l")
-    ex, ey = get("ex"), get("ey")
-    geometry = np.array([ex, ey, -ex, ey, L1, L2, l1, l2,
-                         get("cx"), get("cy"), get("dx"), get("dy")])
-    return Robot(geometry=geometry, H=get("H"), b=get("b"), h=get("h"), name=name,
-                 mechanism_name=str(keys.get("mechanism", "planar_2dof")), source=source,
+
+def _from_keys(keys: dict, name: str, source: str, where=None) -> Robot:
+    """A :class:`Robot` from checked keys (flat or in ``geometry``/``workspace`` tables)."""
+    where = where or (lambda key: source)
+    mech = get_mechanism(str(keys.get("mechanism", DEFAULT_MECHANISM)))
+    flat = {k: v for k, v in keys.items() if k not in TOP_KEYS + TABLES}
+    geo = {**{k: v for k, v in flat.items() if k not in SHAPES[mech.workspace].keys}, **keys.get("geometry", {})}
+    ws_values = {**{k: v for k, v in flat.items() if k in SHAPES[mech.workspace].keys}, **keys.get("workspace", {})}
+    ws_values.pop("shape", None)
+    ws_cls = SHAPES[mech.workspace]
+    geometry = _geometry(mech, geo, where)
+    missing = [k for k in ws_cls.keys if k not in ws_values]
+    if missing:
+        raise RobotFileError(f"missing key(s): {', '.join(missing)}", where=where(None))
+    home = keys.get("home")
+    return Robot(geometry=geometry, workspace=ws_cls(**{k: float(ws_values[k]) for k in ws_cls.keys}),
+                 name=name, mechanism_name=mech.name, source=source,
                  singularity_margin=float(keys.get("singularity_margin", DEFAULT_SINGULARITY_MARGIN)),
-                 keys=dict(keys))
+                 home=None if home is None else np.radians(np.asarray(home, float)), keys=dict(keys))
 
 
 def paper_robot() -> Robot:
-    """The paper's robot (Table 1), validated."""
-    return _from_keys(PAPER_TABLE1, "paper", "built-in (Mei et al. 2017, Table 1)", None)
+    """The paper's robot (Table 1)."""
+    return _from_keys(PAPER_TABLE1, "paper", "built-in (Mei et al. 2017, Table 1)")
 
 
 def _line_of(text: str, key: str):
@@ -142,6 +201,66 @@ def _line_of(text: str, key: str):
         if re.match(rf"\s*({re.escape(key)}\s*=|\[\s*{re.escape(key)}\s*\])", line):
             return i
     return None
+
+
+def _check_number(k, v, unit, where):
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise RobotFileError(f"key '{k}' must be a number ({unit}), got {v!r}", where=where(k))
+    try:
+        ok = np.isfinite(float(v))
+    except OverflowError:
+        ok = False
+    if not ok:
+        raise RobotFileError(f"key '{k}' must be a finite number, got {v!r}", where=where(k))
+
+
+def _check_keys(keys: dict, where) -> None:
+    """Types, names and units of every key, before anything is computed."""
+    for k in ("name", "mechanism", "units"):
+        if k in keys and not isinstance(keys[k], str):
+            raise RobotFileError(f"key '{k}' must be a string", where=where(k))
+    mech_name = keys.get("mechanism", DEFAULT_MECHANISM)
+    if mech_name not in REGISTRY:
+        raise RobotFileError(f"unknown mechanism {mech_name!r} (known: {', '.join(REGISTRY)})",
+                             where=where("mechanism"))
+    if keys.get("units", "mm") != "mm":
+        raise RobotFileError(f"units = {keys['units']!r} is not supported: robot files are in mm",
+                             where=where("units"))
+    mech = get_mechanism(mech_name)
+    ws_cls = SHAPES[mech.workspace]
+    geo_keys = tuple(mech.geometry_names) + tuple(mech.aliases)
+
+    def unit(k):
+        return "deg" if mech.geometry_units.get(k) == "rad" else "mm"
+
+    allowed = TOP_KEYS + geo_keys + ws_cls.keys
+    for k, v in keys.items():
+        if k in TABLES and isinstance(v, dict):
+            inner = geo_keys if k == "geometry" else ws_cls.keys + ("shape",)
+            for kk, vv in v.items():
+                if kk not in inner:
+                    raise RobotFileError(f"unknown key '{kk}' in [{k}] (allowed: {', '.join(inner)})",
+                                         where=where(kk))
+                if kk == "shape":
+                    if vv != ws_cls.kind:
+                        raise RobotFileError(f"workspace shape {vv!r} does not fit mechanism {mech.name!r} "
+                                             f"(its workspace is a {ws_cls.kind})", where=where(kk))
+                    continue
+                if kk in keys and kk not in TABLES:
+                    raise RobotFileError(f"key '{kk}' given twice (top level and [{k}])", where=where(kk))
+                _check_number(kk, vv, unit(kk), where)
+            continue
+        if k not in allowed:
+            raise RobotFileError(f"unknown key '{k}' (allowed: {', '.join(allowed + TABLES)})", where=where(k))
+        if k in ("name", "mechanism", "units"):
+            continue
+        if k == "home":
+            if (not isinstance(v, list) or len(v) != mech.m
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)):
+                raise RobotFileError(f"home must be a list of {mech.m} joint angles (deg), got {v!r}",
+                                     where=where(k))
+            continue
+        _check_number(k, v, "mm" if k in ws_cls.keys or k == "singularity_margin" else unit(k), where)
 
 
 def load_robot(path) -> Robot:
@@ -165,33 +284,10 @@ def load_robot(path) -> Robot:
         raise RobotFileError(f"not valid TOML: {exc}", where=str(path)) from None
 
     def where(key):
-        line = _line_of(text, key)
+        line = _line_of(text, key) if key else None
         return f"{path}:{line}" if line else str(path)
 
-    for k, v in keys.items():
-        if k not in REQUIRED + OPTIONAL:
-            raise RobotFileError(f"unknown key '{k}' (allowed: {', '.join(REQUIRED + OPTIONAL)})", where=where(k))
-        if k in ("name", "mechanism", "units"):
-            if not isinstance(v, str):
-                raise RobotFileError(f"key '{k}' must be a string", where=where(k))
-        elif isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise RobotFileError(f"key '{k}' must be a number (mm), got {v!r}", where=where(k))
-        elif not np.isfinite(v):
-            raise RobotFileError(f"key '{k}' must be finite, got {v!r}", where=where(k))
-    missing = [k for k in REQUIRED if k not in keys]
-    for limb in ("L", "l"):
-        if limb not in keys and not all(f"{limb}{i}" in keys for i in (1, 2)):
-            missing.append(f"{limb} (or {limb}1 and {limb}2)")
-    if missing:
-        raise RobotFileError(f"missing key(s): {', '.join(missing)}", where=str(path))
-    if keys.get("units", "mm") != "mm":
-        raise RobotFileError(f"units = {keys['units']!r} is not supported: robot files are in mm",
-                             where=where("units"))
-    mech = keys.get("mechanism", "planar_2dof")
-    from zerocal_sym.model.mechanism import REGISTRY
-
-    if mech not in REGISTRY:
-        raise RobotFileError(f"unknown mechanism {mech!r} (known: {', '.join(REGISTRY)})", where=where("mechanism"))
+    _check_keys(keys, where)
     robot = _from_keys(keys, str(keys.get("name", path.stem)), str(path), where)
     validate(robot, where=where)
     return robot
@@ -200,16 +296,18 @@ def load_robot(path) -> Robot:
 def validate(robot: Robot, where=None) -> dict:
     """Check that the robot is usable over its whole workspace.
 
-    Checks: positive link lengths and workspace sizes; lengths that look like mm;
-    every workspace corner (and a 25 x 9 grid) reachable; forward and inverse
-    kinematics consistent there (same branch and assembly mode); every
-    ``|sin|`` of the transmission angles at least ``robot.singularity_margin``.
+    Checks: positive lengths (the mechanism's ``POSITIVE`` entries) and
+    workspace sizes; lengths that look like mm; every workspace corner (rim)
+    and a grid over the workspace reachable; forward and inverse kinematics
+    consistent there (same branch and assembly mode); every singularity
+    indicator ``|s|`` at least ``robot.singularity_margin``.
 
     Returns
     -------
     dict
-        Summary: home pose, joint angles at the corners (deg), the smallest
-        transmission sine found and where.
+        Summary: home pose, joint angles at the corners (deg), the joint range
+        over the grid, the largest ``|FK(IK(P)) - P|``, the smallest
+        singularity indicator found and where.
 
     Raises
     ------
@@ -219,51 +317,67 @@ def validate(robot: Robot, where=None) -> dict:
     from zerocal_sym.model.kinematics import fk, ik, transmission
 
     where = where or (lambda key: robot.source)
-    for key in ("L1", "L2", "l1", "l2"):
+    mech = robot.mechanism
+
+    def key_of(name):
+        if name in robot.keys or name in robot.keys.get("geometry", {}):
+            return name
+        return next((a for a, parts in mech.aliases.items() if name in parts), name)
+
+    for key in mech.positive:
         if robot.param(key) <= 0:
-            k = key if key in robot.keys else key[0]
-            raise RobotFileError(f"link length {key} must be positive, got {robot.param(key):g}", where=where(k))
-    for key in ("b", "h"):
-        if getattr(robot, key) <= 0:
-            raise RobotFileError(f"workspace size {key} must be positive, got {getattr(robot, key):g}",
-                                 where=where(key))
-    if robot.param("L1") + robot.param("l1") < 10:
-        raise RobotFileError("link lengths look like metres: robot files are in mm", where=where("L"))
+            raise RobotFileError(f"length {key} must be positive, got {robot.param(key):g}", where=where(key_of(key)))
+    for key in robot.workspace.sizes:
+        v = getattr(robot.workspace, key)
+        if v <= 0:
+            raise RobotFileError(f"workspace size {key} must be positive, got {v:g}", where=where(key))
+    if max(robot.param(k) for k in mech.positive) < 10:
+        raise RobotFileError("link lengths look like metres: robot files are in mm", where=where(key_of(mech.positive[0])))
     if not 0 < robot.singularity_margin < 1:
         raise RobotFileError("singularity_margin must be in (0, 1)", where=where("singularity_margin"))
-    corners = robot.workspace_corners()
+
+    def fmt(p):
+        return "(" + ", ".join(f"{v:g}" for v in p) + ")"
+
     summary = {"home_pose_mm": None, "corners": {}}
-    for label, xy in corners.items():
+    for label, p in robot.workspace_corners().items():
         try:
-            th = ik(robot, np.array([xy]))
+            th = ik(robot, np.array([p]))
         except PoseError:
-            raise RobotFileError(f"workspace corner {label} = ({xy[0]:g}, {xy[1]:g}) mm is unreachable",
-                                 where=robot.source) from None
-        summary["corners"][label] = {"pose_mm": list(xy), "joints_deg": np.degrees(th[0]).tolist()}
+            raise RobotFileError(f"workspace corner {label} = {fmt(p)} mm is unreachable", where=robot.source) from None
+        summary["corners"][label] = {"pose_mm": list(p), "joints_deg": np.degrees(th[0]).tolist()}
     grid = robot.workspace_grid()
     try:
         th = ik(robot, grid)
     except PoseError as exc:
         raise RobotFileError(f"part of the workspace is unreachable: {exc}", where=robot.source) from None
     back = fk(robot, th)
-    bad = np.flatnonzero(~(np.linalg.norm(back - grid, axis=1) < 1e-6))
+    dev = np.linalg.norm(back - grid, axis=1)
+    bad = np.flatnonzero(~(dev < 1e-6))
     if bad.size:
-        x, y = grid[bad[0]]
-        raise RobotFileError(f"forward and inverse kinematics disagree at ({x:g}, {y:g}) mm: "
+        raise RobotFileError(f"forward and inverse kinematics disagree at {fmt(grid[bad[0]])} mm: "
                              "the workspace crosses an assembly-mode change", where=robot.source)
     s = np.abs(transmission(robot, grid, th))
     k = int(np.argmin(np.min(s, axis=1)))
     smin = float(np.min(s[k]))
     if smin < robot.singularity_margin:
         raise RobotFileError(
-            f"configuration near-singular at ({grid[k, 0]:g}, {grid[k, 1]:g}) mm: min |sin transmission angle| "
-            f"= {smin:.3g} < singularity_margin {robot.singularity_margin:g}", where=robot.source)
+            f"configuration near-singular at {fmt(grid[k])} mm: min |singularity indicator| "
+            f"(sine of a transmission angle) = {smin:.3g} < singularity_margin {robot.singularity_margin:g}",
+            where=robot.source)
     home = robot.home_pose()
+    if not np.all(np.isfinite(home)):
+        raise RobotFileError("the home joints are not an assembly of the robot", where=where("home"))
     summary.update(
         name=robot.name, source=robot.source, mechanism=robot.mechanism_name,
+        description=mech.description,
         home_pose_mm=home.tolist(),
+        home_joints_deg=np.degrees(robot.home_joints()).tolist(),
         geometry_mm=robot.to_dict(),
-        workspace_mm={"x": [-robot.b / 2, robot.b / 2], "y": [robot.H, robot.H + robot.h]},
+        workspace=robot.workspace.kind,
+        workspace_mm=robot.workspace.ranges(),
+        joint_range_deg=[float(np.degrees(th.min())), float(np.degrees(th.max()))],
+        fk_ik_max_error_mm=float(dev.max()),
         singularity_margin=robot.singularity_margin,
         min_transmission_sine=smin,
         min_transmission_sine_at_mm=grid[k].tolist(),

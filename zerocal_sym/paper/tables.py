@@ -22,7 +22,10 @@ from __future__ import annotations
 import numpy as np
 
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.model.noise import source_errors
+from zerocal_sym.model.mechanism import get_mechanism
+
+#: The paper's mechanism: Table 2 names its source errors.
+PLANAR = get_mechanism("planar_2dof").errors
 
 # ---------------------------------------------------------------- Table 2
 #: Geometric error "set A" of the paper's Table 2, mm.
@@ -45,12 +48,13 @@ def table2_errors(group: int, geometric: bool = True) -> np.ndarray:
         raise ValueError(f"group must be 1..6, got {group}")
     t1, t2, s, maemm = TABLE2[group]
     geo = {k: s * v for k, v in SET_A.items()} if geometric else None
-    return source_errors((t1, t2), geo, maemm)
+    return PLANAR.assemble((t1, t2), geo, maemm)
 
 
 # ---------------------------------------------------------------- frames
-#: Sign of each source error (SOURCE_ERROR_NAMES order) under the mirror y -> -y.
-MIRROR_Y = np.array([-1, -1, 1, -1, 1, -1, 1, 1, 1, 1, 1, -1], dtype=float)
+#: Sign of each source error under the mirror y -> -y (angles and y components flip).
+MIRROR_Y = PLANAR.vector({n: 1.0 for n in PLANAR.names}) - 2 * PLANAR.vector(
+    {n: 1.0 for n in ("theta1", "theta2", "e1y", "e2y", "rMy")})
 FRAMES = ("paper", "literal")
 #: The paper's MAEMM prior (1, 0.5) mm read in the paper's (mirrored) frame, in our frame.
 DEFAULT_MAEMM_PRIOR = (1.0, -0.5)
@@ -123,4 +127,4 @@ def to_table_frame(vec, frame: str, which: str):
     v = np.asarray(vec, float)
     if frame == "literal":
         return v.copy()
-    return v * (MIRROR_Y[[0, 1]] if which == "offsets" else MIRROR_Y[[10, 11]])
+    return v * PLANAR.take(MIRROR_Y, PLANAR.zero_offsets if which == "offsets" else PLANAR.measuring)

@@ -1,0 +1,1 @@
+"""One derivation module per mechanism (each defines ``build() -> SymbolicMechanism``)."""
