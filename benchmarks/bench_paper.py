@@ -41,7 +41,8 @@ def main():
     from zerocal_sym.paper.reproduction import reproduce
     from zerocal_sym.paper.tables import group_errors
     from zerocal_sym.model.robot import paper_robot
-    from zerocal_sym.paper.scheme import identification_matrix, paper_poses
+    from zerocal_sym.paper.scheme import paper_poses
+    from zerocal_sym.identify.linear import identification_matrix
     from zerocal_sym.identify.tsvd import identify_tsvd, tsvd_solve
 
     robot = paper_robot()

@@ -123,6 +123,7 @@ def render(mech, sources) -> str:
         f"MEASURING_BASE = {[str(s) for s in mech.base_point]!r}",
         f"MEASURING_OFFSET = {[str(s) for s in mech.platform_offset]!r}",
         f"GAUGE_NAMES = {list(mech.gauge)!r}",
+        f"GAUGE_FIX = {list(mech.gauge_fix)!r}",
         f"WORKSPACE = {mech.workspace!r}",
         f"ALIASES = {mech.aliases!r}",
         f"DEFAULTS = {mech.defaults!r}",

@@ -124,6 +124,9 @@ class SymbolicMechanism:
         Named parameter sets particular to this mechanism (beside the generic ones).
     positive : tuple of str
         Geometry entries that must be positive (link lengths, radii).
+    gauge_fix : tuple of str
+        Source errors held at zero to fix the gauge (one per gauge motion):
+        the rest of ``all`` is identifiable from enough poses.
     extra_outputs : dict
         Mechanism-specific outputs (name -> spec, as in :func:`derive`).
     """
@@ -149,6 +152,7 @@ class SymbolicMechanism:
     defaults: dict = field(default_factory=dict)
     param_sets: dict = field(default_factory=dict)
     positive: tuple = ()
+    gauge_fix: tuple = ()
     extra_outputs: dict = field(default_factory=dict)
     outputs: dict = field(default_factory=dict)
 
@@ -192,6 +196,7 @@ class SymbolicMechanism:
         assert all(e.target in geo for e in self.errors("geometry")), "geometry errors target geometry symbols"
         roles = [e.role for e in self.source_errors]
         assert roles == sorted(roles, key=ROLES.index), "order: zero offsets, geometry, measuring"
+        assert len(self.gauge_fix) == len(self.gauge) and set(self.gauge_fix) <= set(names), "one fix per gauge"
         for gname, gen in self.gauge.items():
             assert len(gen) == len(self.source_errors), f"gauge {gname}: one entry per source error"
         known = {str(s) for s in self.geometry}

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 import twin
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError
-from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, VirtualPlant
+from zerocal_sym.model.noise import VirtualPlant
 
 xs = st.floats(-240, 240)
 ys = st.floats(632, 782)
@@ -65,7 +65,7 @@ def _assert_jacobian_matches_central_differences(robot, P):
         e = np.zeros(12)
         e[j] = h
         fd = (_perturbed_pose(robot, th, e) - _perturbed_pose(robot, th, -e)) / (2 * h)
-        assert J[:, j] == pytest.approx(fd, rel=1e-5, abs=1e-6), SOURCE_ERROR_NAMES[j]
+        assert J[:, j] == pytest.approx(fd, rel=1e-5, abs=1e-6), robot.errors.names[j]
 
 
 def test_paper_jacobians_are_scaled_source_jacobian(robot):
@@ -73,7 +73,7 @@ def test_paper_jacobians_are_scaled_source_jacobian(robot):
     Jsrc = kin.pose_error_jacobian(robot, P)
     Jfull = kin.error_jacobian_full(robot, P)
     J = kin.error_jacobian(robot, P)
-    L1, L2 = robot.link_lengths
+    L1, L2 = robot.params(["L1", "L2"])
     # the simplified J equals the zero-offset columns of J'
     assert J[:, :, 0] == pytest.approx(Jfull[:, :, 0], abs=1e-14)
     assert J[:, :, 1] == pytest.approx(Jfull[:, :, 5], abs=1e-14)

@@ -5,8 +5,8 @@ import pytest
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-from zerocal_sym.identify.loop import calibration_loop, simulate_round
-from zerocal_sym.paper.reproduction import home_error, kappas, position_errors, reproduce, run_group, select_n
+from zerocal_sym.identify.loop import calibration_loop, home_error, position_errors, simulate_round
+from zerocal_sym.paper.reproduction import kappas, reproduce, run_group, select_n
 from zerocal_sym.paper.tables import (DEFAULT_MAEMM_PRIOR, PAPER_KAPPA_1, PAPER_KAPPA_M, PAPER_TABLE3, PAPER_TABLE4,
                                       PAPER_TABLE6, group_errors)
 from zerocal_sym.identify.result import IdentificationResult
@@ -110,7 +110,8 @@ def test_loop_takes_any_identifier(robot, poses):
 
     def oracle(robot_, meas, prior):
         seen.append(prior.copy())
-        return IdentificationResult("oracle", ("theta1", "theta2", "rMx", "rMy"), err[[0, 1, 10, 11]].copy())
+        return IdentificationResult("oracle", ("theta1", "theta2", "rMx", "rMy"), err[[0, 1, 10, 11]].copy(),
+                                    errors=robot.errors)
 
     loop = calibration_loop(robot, VirtualPlant(robot, err), poses, identify=oracle, maemm_prior=(0.5, 0.5))
     assert loop.converged and loop.iterations == 2 and loop.history[1].mu_deg == 0.0
@@ -121,7 +122,8 @@ def test_loop_takes_any_identifier(robot, poses):
 
 def test_loop_rejects_failed_identification(robot, poses):
     def failing(robot_, meas, prior):
-        return IdentificationResult("x", ("theta1", "theta2"), np.zeros(2), success=False, status="diverged")
+        return IdentificationResult("x", ("theta1", "theta2"), np.zeros(2), success=False, status="diverged",
+                                    errors=robot.errors)
 
     with pytest.raises(ZerocalError, match="diverged"):
         calibration_loop(robot, VirtualPlant(robot, group_errors(1)), poses, identify=failing)

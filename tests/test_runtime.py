@@ -33,9 +33,10 @@ def test_help_path_does_not_import_casadi():
     assert r.returncode == 0, r.stderr
 
 
-def test_source_error_names_match_the_generated_mechanism(robot):
-    """The numeric layers' parameter order is the derivation's (one source of truth)."""
-    from zerocal_sym.model.noise import SOURCE_ERROR_NAMES
+def test_source_error_names_come_from_the_generated_mechanism(robot):
+    """One source of truth: the numeric layers read the derivation's names, roles and order."""
+    from zerocal_sym.generated import planar_2dof as gen
 
-    assert tuple(robot.mechanism.source_error_names) == SOURCE_ERROR_NAMES
+    assert robot.errors.names == tuple(gen.SOURCE_ERROR_NAMES)
+    assert robot.errors.zero_offsets == ("theta1", "theta2") and robot.errors.measuring == ("rMx", "rMy")
     assert robot.mechanism.geometry_names[:8] == ["e1x", "e1y", "e2x", "e2y", "L1", "L2", "l1", "l2"]

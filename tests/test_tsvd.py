@@ -6,7 +6,7 @@ from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
-from zerocal_sym.model.noise import NoiseModel, VirtualPlant, source_errors
+from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.identify.loop import simulate_round
 from zerocal_sym.paper.scheme import paper_poses
 from zerocal_sym.identify.tsvd import identify_tsvd, tsvd_solve
@@ -83,7 +83,7 @@ def test_unknown_rule():
 @pytest.fixture(scope="module")
 def setup(robot):
     P = paper_poses(robot, 3)
-    err = source_errors((-2.0, 1.0), None, (1.0, -0.5))
+    err = robot.errors.assemble((-2.0, 1.0), None, (1.0, -0.5))
     return P, VirtualPlant(robot, err), err
 
 

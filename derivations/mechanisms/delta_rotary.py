@@ -140,5 +140,6 @@ def build() -> SymbolicMechanism:
         param_sets={"lengths": ("L1", "L2", "L3", "l1", "l2", "l3"),
                     "base": ("R1", "R2", "R3", "phi1", "phi2", "phi3", "z1", "z2", "z3")},
         positive=("R1", "R2", "R3", "L1", "L2", "L3", "l1", "l2", "l3", "r"),
+        gauge_fix=("z1", "phi1"),  # shoulder 1 at its nominal height and azimuth
     )
     return derive(mech)

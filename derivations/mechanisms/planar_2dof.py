@@ -121,6 +121,7 @@ def build() -> SymbolicMechanism:
                  "L": {"L1": 1.0, "L2": 1.0}, "l": {"l1": 1.0, "l2": 1.0}},
         param_sets={"lengths": ("L1", "L2", "l1", "l2"), "base": ("e1x", "e1y", "e2x", "e2y")},
         positive=("L1", "L2", "l1", "l2"),
+        gauge_fix=("e1x", "e1y", "e2y"),  # A1 exact, A2 on the same horizontal
     )
 
     # --- the paper's Eq. (12): per limb (L_i dth_i, de_ix, de_iy, dL_i, dl_i)

@@ -23,7 +23,8 @@ def run(args):
     from zerocal_sym.model.noise import NoiseModel
     from zerocal_sym.paper.reproduction import kappas, select_n
     from zerocal_sym.paper.tables import DEFAULT_MAEMM_PRIOR, MAEMM_PRIOR_READINGS, PAPER_KAPPA_1, PAPER_KAPPA_M
-    from zerocal_sym.paper.scheme import identification_matrix, paper_poses
+    from zerocal_sym.paper.scheme import paper_poses
+    from zerocal_sym.identify.linear import identification_matrix
 
     robot = load_robot_arg(args)
     prior = tuple(float(v) for v in args.maemm_prior) if args.maemm_prior else DEFAULT_MAEMM_PRIOR

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 06b65d5cdfe9a989
+inputs hash: 7aa66b8f5bd57090
 sympy: 1.14.0
 """
 import casadi as ca
@@ -42,6 +42,7 @@ HOME_JOINTS = [0.0, 0.0, 0.0]
 MEASURING_BASE = ['cx', 'cy', 'cz']
 MEASURING_OFFSET = ['dx', 'dy', 'dz']
 GAUGE_NAMES = ['translation z', 'rotation about z']
+GAUGE_FIX = ['z1', 'phi1']
 WORKSPACE = 'cylinder'
 ALIASES = {'R': {'R1': 1.0, 'R2': 1.0, 'R3': 1.0}, 'L': {'L1': 1.0, 'L2': 1.0, 'L3': 1.0}, 'l': {'l1': 1.0, 'l2': 1.0, 'l3': 1.0}}
 DEFAULTS = {'phi1': 0.0, 'phi2': 120.0, 'phi3': 240.0, 'z1': 0.0, 'z2': 0.0, 'z3': 0.0}

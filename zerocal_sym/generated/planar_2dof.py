@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: 5990e5590bde8870
+inputs hash: 8293b2a0c47ccdf6
 sympy: 1.14.0
 """
 import casadi as ca
@@ -33,6 +33,7 @@ HOME_JOINTS = [0.0, 3.141592653589793]
 MEASURING_BASE = ['cx', 'cy']
 MEASURING_OFFSET = ['dx', 'dy']
 GAUGE_NAMES = ['translation x', 'translation y', 'rotation about O']
+GAUGE_FIX = ['e1x', 'e1y', 'e2y']
 WORKSPACE = 'rectangle'
 ALIASES = {'ex': {'e1x': 1.0, 'e2x': -1.0}, 'ey': {'e1y': 1.0, 'e2y': 1.0}, 'L': {'L1': 1.0, 'L2': 1.0}, 'l': {'l1': 1.0, 'l2': 1.0}}
 DEFAULTS = {}

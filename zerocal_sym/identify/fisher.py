@@ -19,71 +19,23 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError
-from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, NoiseModel
-
-#: Named parameter sets (indices into the source-error vector).
-PARAM_SETS = {
-    "paper": ("theta1", "theta2", "rMx", "rMy"),
-    "offsets": ("theta1", "theta2"),
-    "maemm": ("rMx", "rMy"),
-    "geometric": ("e1x", "e1y", "e2x", "e2y", "L1", "L2", "l1", "l2"),
-    "lengths": ("L1", "L2", "l1", "l2"),
-    "base": ("e1x", "e1y", "e2x", "e2y"),
-    "all": SOURCE_ERROR_NAMES,
-}
-
-
-def param_indices(params) -> list:
-    """Indices of the named parameters, in the source-error order.
-
-    Parameters
-    ----------
-    params : str or sequence of str
-        A set name of :data:`PARAM_SETS`, parameter names, or a string
-        combining both with ``,`` or ``+`` (``"paper+L1,L2"``).  Duplicates
-        are dropped; the result is sorted in :data:`SOURCE_ERROR_NAMES` order.
-
-    Returns
-    -------
-    list of int
-    """
-    if isinstance(params, str):
-        params = [p.strip() for p in params.replace("+", ",").split(",") if p.strip()]
-    names = []
-    for p in params:
-        names.extend(PARAM_SETS[p] if p in PARAM_SETS else [p])
-    idx = set()
-    for p in names:
-        if p not in SOURCE_ERROR_NAMES:
-            raise ValueError(f"unknown parameter {p!r} (known: {', '.join(SOURCE_ERROR_NAMES)}; "
-                             f"sets: {', '.join(PARAM_SETS)})")
-        idx.add(SOURCE_ERROR_NAMES.index(p))
-    if not idx:
-        raise ValueError("empty parameter set")
-    return sorted(idx)
-
-
-def param_names(params) -> tuple:
-    """Names of the parameters selected by ``params`` (see :func:`param_indices`)."""
-    return tuple(SOURCE_ERROR_NAMES[i] for i in param_indices(params))
-
+from zerocal_sym.model.noise import NoiseModel
 
 def parameter_scale(robot, params="paper") -> np.ndarray:
     """Column scaling that makes rad and mm comparable, shape (p,).
 
-    A zero offset is measured by the arc it moves the proximal link's end,
-    ``L_i dtheta_i`` (mm) -- the paper's own ``dq = (L1 dth1, L2 dth2)``; every
-    other parameter is a length already (mm).  So the scaled parameter is
-    ``q = c * p`` with ``c = L_i`` (mm/rad) for ``theta_i`` and 1 otherwise, and
-    the scaled sensitivity is ``A / c``.
+    An angle is measured by the arc it moves its lever arm, ``L_i dtheta_i``
+    (mm) -- the paper's own ``dq = (L1 dth1, L2 dth2)``; every other
+    parameter is a length already (mm).  So the scaled parameter is
+    ``q = c * p`` with ``c`` the lever arm (mm/rad) of an angle and 1
+    otherwise, and the scaled sensitivity is ``A / c``.
 
     Returns
     -------
     ndarray, shape (p,)
         mm per unit of each parameter.
     """
-    L = robot.link_lengths
-    return np.array([L[i] if i < 2 else 1.0 for i in param_indices(params)])
+    return robot.error_scale(robot.errors.resolve(params))
 
 
 def difference_matrix(K: int) -> np.ndarray:
@@ -96,10 +48,11 @@ def sensitivity(robot, theta_cmd, params="paper", err0=None):
 
     Parameters
     ----------
-    theta_cmd : ndarray, shape (K, 2)
+    theta_cmd : ndarray, shape (K, m)
         Commanded joints, rad.
     params : str or list of str
-    err0 : ndarray, shape (12,), optional
+        Parameter set (names or set names, see :meth:`SourceErrors.resolve`).
+    err0 : ndarray, shape (q,), optional
         Linearisation point (default zero).
 
     Returns
@@ -108,7 +61,7 @@ def sensitivity(robot, theta_cmd, params="paper", err0=None):
         Per rad for zero offsets, per mm for lengths.
     """
     _, de, _ = kin.distance_jacobians(robot, theta_cmd, err0)
-    return np.diff(de[:, param_indices(params)], axis=0)
+    return np.diff(de[:, robot.errors.indices(params)], axis=0)
 
 
 def measurement_covariance(robot, theta_cmd, noise: NoiseModel, err0=None):
@@ -180,10 +133,19 @@ def crlb(robot, theta_cmd, params="paper", noise: NoiseModel | None = None, err0
 
 
 def crlb_zero_offsets_deg(robot, theta_cmd, params="paper", noise=None, err0=None, prior_std=None):
-    """CRLB standard deviations of the two zero offsets, degrees, shape (2,)."""
-    idx = param_indices(params)
+    """CRLB standard deviations of the zero offsets, degrees, shape (m,).
+
+    Raises
+    ------
+    ValueError
+        If ``params`` does not contain every zero offset.
+    """
+    names = robot.errors.resolve(params)
+    missing = [n for n in robot.errors.zero_offsets if n not in names]
+    if missing:
+        raise ValueError(f"the parameter set does not contain the zero offsets {', '.join(missing)}")
     cov = crlb(robot, theta_cmd, params, noise, err0, prior_std)
-    pos = [idx.index(0), idx.index(1)]
+    pos = [names.index(n) for n in robot.errors.zero_offsets]
     return np.degrees(np.sqrt(np.diag(cov)[pos]))
 
 
@@ -197,12 +159,12 @@ def model_bias(robot, theta_cmd, err_true, params="paper", noise: NoiseModel | N
 
     Parameters
     ----------
-    theta_cmd : ndarray, shape (K, 2)
-    err_true : ndarray, shape (12,)
+    theta_cmd : ndarray, shape (K, m)
+    err_true : ndarray, shape (q,)
         True source errors (rad, mm).
     noise : NoiseModel, optional
         Weighting (default: the paper's); a zero model means unweighted.
-    err0 : ndarray, shape (12,), optional
+    err0 : ndarray, shape (q,), optional
         Linearisation point and the value the model assumes for the omitted errors.
 
     Returns
@@ -211,9 +173,9 @@ def model_bias(robot, theta_cmd, err_true, params="paper", noise: NoiseModel | N
         Bias of each parameter (rad, mm).
     """
     noise = NoiseModel.paper() if noise is None else noise
-    idx = param_indices(params)
-    omit = [i for i in range(len(SOURCE_ERROR_NAMES)) if i not in idx]
-    err0 = np.zeros(len(SOURCE_ERROR_NAMES)) if err0 is None else np.asarray(err0, float)
+    idx = robot.errors.indices(params)
+    omit = [i for i in range(len(robot.errors)) if i not in idx]
+    err0 = robot.errors.zeros() if err0 is None else robot.errors.check_vector(err0)
     _, de, _ = kin.distance_jacobians(robot, theta_cmd, err0)
     A, Ao = np.diff(de[:, idx], axis=0), np.diff(de[:, omit], axis=0)
     if noise.is_zero:

@@ -2,12 +2,15 @@
 
 * :func:`simulate_round` -- one identification round on a virtual plant;
 * :func:`calibration_loop` -- identify, compensate, re-measure, identify the
-  remainder until ``mu < mu0`` (Eq. 30-33), with a pluggable identifier.
+  remainder until ``mu < mu0`` (Eq. 30-33), with a pluggable identifier;
+* :func:`position_errors`, :func:`home_error` -- how far the actual robot
+  misses nominal poses after a compensation.
 
 Stopping rule
 -------------
-``mu_j = sqrt(((c1_j - c1_{j-1})^2 + (c2_j - c2_{j-1})^2) / 2)`` with ``c_j``
-the compensation value (sum of the increments) after the ``j``-th
+``mu_j = sqrt(sum_i (c_i,j - c_i,j-1)^2 / m)`` over the m joints (the paper's
+``sqrt(((c1_j - c1_{j-1})^2 + (c2_j - c2_{j-1})^2) / 2)``) with ``c_j`` the
+compensation value (sum of the increments) after the ``j``-th
 identification, i.e. the RMS of the ``j``-th increment; defined from ``j = 2``.
 """
 from __future__ import annotations
@@ -17,12 +20,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from zerocal_sym.errors import IdentificationError
+from zerocal_sym.identify.linear import condition_number, identification_matrix
 from zerocal_sym.identify.tsvd import identify_tsvd
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
 
 
-def simulate_round(robot, plant, poses, compensation_rad=(0.0, 0.0), noise=None, rng=None) -> Measurements:
+def simulate_round(robot, plant, poses, compensation_rad=None, noise=None, rng=None) -> Measurements:
     """One identification round: command the poses, read the scale.
 
     Parameters
@@ -30,23 +34,52 @@ def simulate_round(robot, plant, poses, compensation_rad=(0.0, 0.0), noise=None,
     robot : Robot
         Nominal robot (the controller's model).
     plant : VirtualPlant
-    poses : ndarray, shape (K, 2)
+    poses : ndarray, shape (K, n)
         Nominal target poses, mm, in visiting order.
-    compensation_rad : (2,)
-        Current compensation: commanded = IK(poses) - compensation.
+    compensation_rad : sequence of m floats, optional
+        Current compensation: commanded = IK(poses) - compensation (default zero).
     noise : NoiseModel, optional
     rng : numpy Generator or seed, optional
 
     Returns
     -------
     Measurements
-        ``theta_cmd`` (K, 2) rad, ``readings`` (K,) mm, ``target`` = poses.
+        ``theta_cmd`` (K, m) rad, ``readings`` (K,) mm, ``target`` = poses.
     """
     poses = np.atleast_2d(np.asarray(poses, float))
-    theta_cmd = kin.ik(robot, poses) - np.asarray(compensation_rad, float)
+    comp = np.zeros(robot.m) if compensation_rad is None else np.asarray(compensation_rad, float)
+    theta_cmd = kin.ik(robot, poses) - comp
     readings = plant.measure(theta_cmd, noise, rng)
     return Measurements(theta_cmd=theta_cmd, readings=readings, target=poses.copy(),
                         meta={}, source="<simulated>")
+
+
+def position_errors(robot, plant, poses, compensation_rad=None) -> np.ndarray:
+    """``|P_actual - P|`` at nominal poses commanded as ``IK(P) - compensation``.
+
+    Exact forward kinematics of the actual robot (no noise).
+
+    Parameters
+    ----------
+    poses : ndarray, shape (K, n)
+    compensation_rad : sequence of m floats, optional
+
+    Returns
+    -------
+    ndarray, shape (K,)
+        mm.
+    """
+    poses = np.atleast_2d(np.asarray(poses, float))
+    comp = np.zeros(robot.m) if compensation_rad is None else np.asarray(compensation_rad, float)
+    th = kin.ik(robot, poses) - comp
+    return np.linalg.norm(plant.actual_pose(th) - poses, axis=1)
+
+
+def home_error(robot, plant, compensation_rad=None) -> float:
+    """``dp0``: distance from P0 of the platform commanded to home (minus the compensation), mm."""
+    comp = np.zeros(robot.m) if compensation_rad is None else np.asarray(compensation_rad, float)
+    th = robot.home_joints()[None, :] - comp
+    return float(np.linalg.norm(plant.actual_pose(th)[0] - robot.home_pose()))
 
 
 @dataclass
@@ -56,14 +89,14 @@ class IterationRecord:
     Attributes
     ----------
     result : IdentificationResult
-    compensation_deg : ndarray, shape (2,)
+    compensation_deg : ndarray, shape (m,)
         Compensation value (sum of increments) after this identification, our frame.
-    increment_deg : ndarray, shape (2,)
+    increment_deg : ndarray, shape (m,)
     mu_deg : float or None
         Compensation accuracy (None at the first identification).
     kappa : float
-        Condition number of G of this identification (NaN if the identifier does not report it).
-    maemm_mm : ndarray, shape (2,)
+        Condition number of G of this identification (Eq. 28's G when the identifier does not report it).
+    maemm_mm : ndarray, shape (n,)
     """
 
     result: object
@@ -81,10 +114,10 @@ class LoopResult:
     Attributes
     ----------
     history : list of IterationRecord
-    compensation_deg : ndarray, shape (2,)
+    compensation_deg : ndarray, shape (m,)
         Compensation value when the loop stopped (at the first ``mu < mu0``
         if it converged, else after the last identification), our frame.
-    maemm_mm : ndarray, shape (2,)
+    maemm_mm : ndarray, shape (n,)
         MAEMM estimate at the same identification.
     converged : bool
     iterations : int
@@ -92,8 +125,8 @@ class LoopResult:
     """
 
     history: list = field(default_factory=list)
-    compensation_deg: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    maemm_mm: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    compensation_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    maemm_mm: np.ndarray = field(default_factory=lambda: np.zeros(0))
     converged: bool = False
     iterations: int = 0
 
@@ -123,8 +156,8 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
     """The paper's iterative identification and compensation (Eq. 30-33).
 
     Each round commands ``IK(poses) - compensation``, measures, and calls
-    ``identify(robot, meas, prior)`` with ``prior`` the 12-vector of the
-    current total estimates (offsets = compensation, MAEMM = previous
+    ``identify(robot, meas, prior)`` with ``prior`` the source-error vector
+    (length q) of the current total estimates (offsets = compensation, MAEMM = previous
     estimate; from the 2nd identification on this corrects the nominal
     measuring-mechanism vector, Eq. 30).  The identifier returns totals; the
     new compensation is its offset estimate (= the sum of the increments).
@@ -133,7 +166,7 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
     ----------
     robot : Robot
     plant : VirtualPlant
-    poses : ndarray, shape (K, 2)
+    poses : ndarray, shape (K, n)
     identify : callable
         ``identify(robot, meas, prior) -> IdentificationResult`` (TSVD by default;
         an Ipopt identifier plugs in the same way).
@@ -143,7 +176,7 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
         Threshold of the compensation accuracy mu.
     max_iter : int
         Maximum number of identifications.
-    maemm_prior : (2,), optional
+    maemm_prior : sequence of n floats, optional
         MAEMM prior of the first identification (default zero, as the paper).
     run_all : bool
         Continue to ``max_iter`` after convergence (the paper's robustness
@@ -156,31 +189,29 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
     if max_iter < 1:
         raise ValueError("max_iter must be >= 1")
     rng = np.random.default_rng(rng)
-    prior = np.zeros(12)
+    errors = robot.errors
+    offs, meas_names = errors.zero_offsets, errors.measuring
+    prior = errors.zeros()
     if maemm_prior is not None:
-        prior[10:12] = np.asarray(maemm_prior, float)
-    out = LoopResult()
-    comp = np.zeros(2)
+        prior = errors.put(prior, meas_names, np.asarray(maemm_prior, float))
+    out = LoopResult(compensation_deg=np.zeros(robot.m), maemm_mm=np.zeros(robot.n))
+    comp = np.zeros(robot.m)
     for j in range(1, max_iter + 1):
         meas = simulate_round(robot, plant, poses, comp, noise, rng)
         res = identify(robot, meas, prior.copy())
         if not getattr(res, "success", True):
             raise IdentificationError(f"identification {j} failed: {res.status}")
-        new = np.array([res.value("theta1"), res.value("theta2")])
-        maemm = np.array([res.value("rMx", prior[10]), res.value("rMy", prior[11])])
+        new = np.array([res.value(n) for n in offs])
+        maemm = np.array([res.value(n, v) for n, v in zip(meas_names, errors.take(prior, meas_names))])
         inc = new - comp
         mu = None if j == 1 else float(np.degrees(np.sqrt(np.mean(inc**2))))
         kappa = float(res.info.get("kappa", np.nan)) if isinstance(res.info, dict) else float("nan")
-        if not np.isfinite(kappa):
-            # the paper's G (Eq. 28): still in zerocal_sym.paper.scheme, imported only on this path
-            from zerocal_sym.paper.scheme import condition_number, identification_matrix
-
-            P = kin.fk(robot, meas.theta_cmd + prior[:2])
-            kappa = condition_number(identification_matrix(robot, P, prior[10:12])[0])
+        if not np.isfinite(kappa):  # the paper's G (Eq. 28) of this round
+            P = kin.fk(robot, meas.theta_cmd + errors.take(prior, offs))
+            kappa = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
         out.history.append(IterationRecord(res, np.degrees(new), np.degrees(inc), mu, kappa, maemm.copy()))
         comp = new
-        prior[:2] = new
-        prior[10:12] = maemm
+        prior = errors.put(errors.put(prior, offs, new), meas_names, maemm)
         if not out.converged:
             out.compensation_deg, out.maemm_mm, out.iterations = np.degrees(new), maemm.copy(), j
             if mu is not None and mu < mu0_deg:

@@ -5,7 +5,7 @@ linearisation)::
 
     s_k = rho(theta_cmd_{k+1}; e) - rho(theta_cmd_k; e) + noise,   k = 1..K-1
 
-with ``e`` the 12 source errors (rad, mm), of which the parameters selected by
+with ``e`` the q source errors of the mechanism (rad, mm), of which the parameters selected by
 ``params`` are estimated and the others held at ``prior`` (default zero).
 
 Weighting (errors-in-variables, marginalised to first order)
@@ -47,7 +47,7 @@ import numpy as np
 
 from zerocal_sym.identify import fisher
 from zerocal_sym.errors import IdentificationError
-from zerocal_sym.model.noise import SOURCE_ERROR_NAMES, NoiseModel
+from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.identify.result import IdentificationResult
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
@@ -81,7 +81,7 @@ class _Problem:
         m = K - 1
         f = mechanism["distance"]
         z = ca.SX.sym("z", self.n)
-        th = ca.SX.sym("theta", 2, K)
+        th = ca.SX.sym("theta", f.size1_in(0), K)
         g = ca.SX.sym("g", f.size1_in(1))
         efix = ca.SX.sym("err_fixed", f.size1_in(2))
         s = ca.SX.sym("s", m)
@@ -133,7 +133,7 @@ class _Problem:
     def pack(self, theta_cmd, geometry, err_fixed, s, W, scale, mu, w, obj_scale=1.0):
         """The NLP parameter vector.
 
-        ``theta_cmd`` shape (K, 2), ``W`` shape (K-1, K-1), ``w`` (prior
+        ``theta_cmd`` shape (K, m), ``W`` shape (K-1, K-1), ``w`` (prior
         whitener) shape (p, p).
         """
         return np.concatenate([np.asarray(theta_cmd, float).ravel(), geometry, err_fixed, s,
@@ -143,7 +143,7 @@ class _Problem:
 
 def get_problem(robot, K: int, params="paper") -> _Problem:
     """The cached NLP for ``K`` poses and the parameter set (built on first use)."""
-    idx = tuple(fisher.param_indices(params))
+    idx = tuple(robot.errors.indices(params))
     key = (robot.mechanism_name, K, idx)
     with _LOCK:
         prob = _CACHE.get(key)
@@ -185,10 +185,9 @@ def _bounds(bounds, names, scale):
     return lo * scale, hi * scale
 
 
-def _initial(robot, meas, params, names, prior12, warm_start):
+def _initial(robot, meas, names, prior_q, warm_start):
     """Initial guess (physical units, shape (p,)) and a note on where it came from."""
-    idx = fisher.param_indices(params)
-    x0 = prior12[idx].copy()
+    x0 = robot.errors.take(prior_q, names)
     if warm_start is None:
         return x0, "prior"
     if isinstance(warm_start, str):
@@ -199,14 +198,14 @@ def _initial(robot, meas, params, names, prior12, warm_start):
         except ImportError:
             return x0, "prior (tsvd unavailable)"
         try:
-            ts = identify_tsvd(robot, meas, prior=prior12)
+            ts = identify_tsvd(robot, meas, prior=prior_q)
         except Exception as exc:  # noqa: BLE001 - a failed warm start is not fatal
             return x0, f"prior (tsvd failed: {exc})"
         for k, n in enumerate(names):
             if n in ts.params and np.isfinite(ts.value(n)):
                 x0[k] = ts.value(n)
         return x0, "tsvd"
-    return _as_vector(warm_start, len(idx), "warm_start"), "given"
+    return _as_vector(warm_start, len(names), "warm_start"), "given"
 
 
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
@@ -218,15 +217,16 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     ----------
     robot : Robot
     meas : Measurements
-        ``theta_cmd`` (K, 2) rad and ``readings`` (K,) mm (``readings[0] = 0``).
+        ``theta_cmd`` (K, m) rad and ``readings`` (K,) mm (``readings[0] = 0``).
     params : str or sequence of str
-        Parameters to estimate (see :func:`zerocal_sym.identify.fisher.param_indices`):
-        ``"paper"`` (theta1 theta2 rMx rMy), ``"all"``, ``"paper+L1,L2"``, ...
+        Parameters to estimate, by name (see :meth:`SourceErrors.resolve`):
+        ``"paper"`` (= ``offsets+measuring``: the zero offsets and the MAEMM),
+        ``"all"``, ``"offsets+measuring+L1,L2"``, ...
     noise : NoiseModel, optional
         Weights and covariance (default: the paper's noise model).  A zero
         model weights every change equally (1 um) and estimates the
         covariance from the residuals.
-    prior : ndarray, shape (12,), optional
+    prior : ndarray, shape (q,), optional
         Current belief about the total source errors (rad, mm): the values
         of the parameters not estimated, the mean of the Gaussian prior of
         those estimated (with ``prior_std``) and the initial guess when
@@ -257,14 +257,17 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     """
     t0 = time.perf_counter()
     noise = NoiseModel.paper() if noise is None else noise
-    names = fisher.param_names(params)
-    idx = fisher.param_indices(params)
+    errors = robot.errors
+    names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
     K = theta_cmd.shape[0]
     if K < 2:
         raise IdentificationError(f"need at least 2 poses, got {K}")
+    if theta_cmd.shape[1] != robot.m:
+        raise IdentificationError(f"measurements have {theta_cmd.shape[1]} joint angles per pose, the robot "
+                                  f"{robot.name!r} has {robot.m} joints", where=getattr(meas, "source", None))
     s = np.asarray(meas.readings, float)[1:]
-    prior12 = np.zeros(len(SOURCE_ERROR_NAMES)) if prior is None else _as_vector(prior, 12, "prior")
+    prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
     scale = fisher.parameter_scale(robot, names)
     if prior_cov is not None:
         if prior_std is not None:
@@ -288,24 +291,22 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         if np.any(std <= 0):
             raise ValueError("prior_std must be positive (inf for no prior)")
         w = np.diag(1.0 / std)
-    mu = prior12[idx]
+    mu = errors.take(prior_q, names)
     lbx, ubx = _bounds(bounds, list(names), scale)
-    x0, start = _initial(robot, meas, names, names, prior12, warm_start)
+    x0, start = _initial(robot, meas, names, prior_q, warm_start)
     z0 = np.clip(x0 * scale, lbx, ubx)
 
     prob = get_problem(robot, K, names)
     solver = prob.solver_for(max_iter)
 
     def full(p):
-        e = prior12.copy()
-        e[idx] = p
-        return e
+        return errors.put(prior_q, names, p)
 
     total_iter, stats = 0, {}
     z = z0
     for rnd in range(1 + max(0, int(reweight))):
         W = _weights(robot, theta_cmd, noise, full(z / scale))
-        par = prob.pack(theta_cmd, robot.geometry, prior12, s, W, scale, mu, w)
+        par = prob.pack(theta_cmd, robot.geometry, prior_q, s, W, scale, mu, w)
         J0 = prob.resfun(z, par)[2].full()
         par[-1] = 1.0 / max(1e-300, np.linalg.norm(J0, 2) ** 2)
         sol = solver(x0=z, p=par, lbx=lbx, ubx=ubx)
@@ -323,7 +324,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     converged = ret in CONVERGED_STATUSES and bool(np.all(np.isfinite(z)))
     p_hat = z / scale
     W = _weights(robot, theta_cmd, noise, full(p_hat))
-    par = prob.pack(theta_cmd, robot.geometry, prior12, s, W, scale, mu, w)
+    par = prob.pack(theta_cmd, robot.geometry, prior_q, s, W, scale, mu, w)
     r, rp, J, pred = (o.full() for o in prob.resfun(z, par))
     r, rp = r.ravel(), rp.ravel()
     Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
@@ -351,7 +352,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             cov[:, k] = np.nan
             cov[k, k] = np.inf
     offsets_ok = all(not (null.size and np.max(np.abs(null[:, names.index(n)])) > 1e-6)
-                     for n in ("theta1", "theta2") if n in names)
+                     for n in errors.zero_offsets if n in names)
     success = converged and offsets_ok
     if not converged:
         status = f"Ipopt did not converge: {ret}"
@@ -379,15 +380,15 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "singular_values": sv.tolist(),
         "nonidentifiable": nonid,
         "scale_mm_per_unit": scale.tolist(),
-        "prior": prior12.tolist(),
+        "prior": prior_q.tolist(),
     }
     return IdentificationResult(method="nlls", params=names, estimate=p_hat,
                                 covariance=cov, success=bool(success), status=status,
-                                residuals=np.asarray(s - pred.ravel()), info=info)
+                                residuals=np.asarray(s - pred.ravel()), info=info, errors=errors)
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):
-    """An ``identify(robot, meas, prior12)`` callable for the calibration loop.
+    """An ``identify(robot, meas, prior)`` callable for the calibration loop.
 
     Parameters
     ----------
@@ -413,7 +414,7 @@ def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequen
         last = state["last"]
         if sequential and last is not None and prior is not None and last.success:
             full = last.full_vector()
-            idx = fisher.param_indices(params)
+            idx = robot.errors.indices(params)
             if np.allclose(np.asarray(prior, float)[idx], full[idx], rtol=0, atol=1e-15) \
                     and last.covariance is not None and np.all(np.isfinite(last.covariance)):
                 kw["prior_cov"] = last.covariance
@@ -441,14 +442,14 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
         ``p = z / scale`` (physical units); start at ``prior[params] * scale``.
     """
     noise = NoiseModel.paper() if noise is None else noise
-    names = fisher.param_names(params)
-    idx = fisher.param_indices(params)
+    errors = robot.errors
+    names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
-    prior12 = np.zeros(len(SOURCE_ERROR_NAMES)) if prior is None else _as_vector(prior, 12, "prior")
+    prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
     scale = fisher.parameter_scale(robot, names)
-    W = _weights(robot, theta_cmd, noise, prior12)
+    W = _weights(robot, theta_cmd, noise, prior_q)
     prob = get_problem(robot, theta_cmd.shape[0], names)
-    par = prob.pack(theta_cmd, robot.geometry, prior12, np.asarray(meas.readings, float)[1:], W, scale,
-                    prior12[idx], np.zeros((len(names), len(names))))
+    par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], W, scale,
+                    errors.take(prior_q, names), np.zeros((len(names), len(names))))
     rfun, jfun = prob.rfun, prob.jfun
     return (lambda z: rfun(z, par).full().ravel()), (lambda z: jfun(z, par).full()), scale

@@ -1,16 +1,16 @@
-"""The result of one identification, whatever the method.
+"""The result of one identification, whatever the method and the mechanism.
 
-Estimates are always of the *total* source errors (rad, mm) in the
-parameters' order, not of increments: an identification linearised at a prior
-(the current compensation and MAEMM estimate) returns prior + increment.
+Estimates are always of the *total* source errors (rad, mm) of the named
+parameters, not of increments: an identification linearised at a prior (the
+current compensation and MAEMM estimate) returns prior + increment.  Every
+parameter is read by name; the zero offsets and the MAEMM come in joint and
+pose-coordinate order from the mechanism's :class:`SourceErrors`.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from zerocal_sym.model.noise import SOURCE_ERROR_NAMES
 
 
 @dataclass
@@ -22,10 +22,9 @@ class IdentificationResult:
     method : str
         ``"tsvd"`` or ``"nlls"`` (or another registered method).
     params : tuple of str
-        Names (from :data:`~zerocal_sym.model.noise.SOURCE_ERROR_NAMES`) of the
-        identified parameters.
+        Names of the identified parameters (a subset of the mechanism's source errors).
     estimate : ndarray, shape (p,)
-        Total source errors, rad for zero offsets, mm otherwise.
+        Total source errors, rad for angles, mm otherwise.
     covariance : ndarray, shape (p, p) or None
         Estimated covariance of ``estimate`` (same units).
     success : bool
@@ -37,6 +36,9 @@ class IdentificationResult:
     info : dict
         Method-specific: ``singular_values``, ``truncation``, ``filter_factors``
         (TSVD); ``iterations``, ``cost``, ``solver_status`` (Ipopt); ...
+    errors : SourceErrors or None
+        The mechanism's source errors (names, roles, units); set by the
+        identification.  Needed for :meth:`full_vector` and the role views.
     """
 
     method: str
@@ -47,6 +49,7 @@ class IdentificationResult:
     status: str = "ok"
     residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
     info: dict = field(default_factory=dict)
+    errors: object = field(default=None, repr=False)
 
     def value(self, name: str, default=0.0) -> float:
         """Estimate of one parameter by name (``default`` if not identified)."""
@@ -60,29 +63,36 @@ class IdentificationResult:
         return float(np.sqrt(self.covariance[k, k]))
 
     def full_vector(self) -> np.ndarray:
-        """The estimate as a 12-vector of source errors (zeros where not identified)."""
-        v = np.zeros(len(SOURCE_ERROR_NAMES))
-        for k, n in enumerate(self.params):
-            v[SOURCE_ERROR_NAMES.index(n)] = self.estimate[k]
-        return v
+        """The estimate as a source-error vector of the mechanism (zeros where not identified), shape (q,)."""
+        return self.errors.vector(dict(zip(self.params, self.estimate)))
+
+    @property
+    def zero_offset_names(self) -> tuple:
+        return self.errors.zero_offsets
+
+    @property
+    def zero_offsets_rad(self) -> np.ndarray:
+        """Zero offsets in joint order (rad), shape (m,)."""
+        return np.array([self.value(n) for n in self.errors.zero_offsets])
 
     @property
     def zero_offsets_deg(self) -> np.ndarray:
-        return np.degrees([self.value("theta1"), self.value("theta2")])
+        return np.degrees(self.zero_offsets_rad)
 
     @property
     def std_zero_offsets_deg(self) -> np.ndarray:
-        return np.degrees([self.std("theta1"), self.std("theta2")])
+        return np.degrees([self.std(n) for n in self.errors.zero_offsets])
 
     @property
     def maemm_mm(self) -> np.ndarray:
-        return np.array([self.value("rMx"), self.value("rMy")])
+        """MAEMM in pose-coordinate order (mm), shape (n,)."""
+        return np.array([self.value(n) for n in self.errors.measuring])
+
+    def user_value(self, name: str, v: float) -> float:
+        return self.errors.to_user_value(name, v)
 
     def to_dict(self) -> dict:
-        """JSON-ready summary (degrees and mm at this edge)."""
-        def deg_or_mm(n, v):
-            return float(np.degrees(v)) if n.startswith("theta") else float(v)
-
+        """JSON-ready summary (degrees and mm at this edge), keyed by parameter name."""
         std = [self.std(n) for n in self.params]
         return {
             "method": self.method,
@@ -92,10 +102,10 @@ class IdentificationResult:
             "std_zero_offsets_deg": [None if not np.isfinite(s) else s for s in self.std_zero_offsets_deg.tolist()],
             "maemm_mm": self.maemm_mm.tolist(),
             "params": list(self.params),
-            "estimate": {n: deg_or_mm(n, v) for n, v in zip(self.params, self.estimate)},
-            "std": {n: (None if not np.isfinite(s) else deg_or_mm(n, s)) for n, s in zip(self.params, std)},
-            "units": {n: ("deg" if n.startswith("theta") else "mm") for n in self.params},
+            "estimate": {n: self.user_value(n, v) for n, v in zip(self.params, self.estimate)},
+            "std": {n: (None if not np.isfinite(s) else self.user_value(n, s)) for n, s in zip(self.params, std)},
+            "units": {n: self.errors[n].user_unit for n in self.params},
             "covariance": None if self.covariance is None else self.covariance.tolist(),
-            "covariance_units": "rad for theta*, mm otherwise (SI-like internal units)",
+            "covariance_units": "rad for angles, mm otherwise (SI-like internal units)",
             "residuals_mm": np.asarray(self.residuals).tolist(),
         }

@@ -1,9 +1,11 @@
 """Identification by truncated SVD (paper Eq. 28-29).
 
 The paper's identification model is linear in the increment ``dp`` of the
-parameters ``(L1 dth1, L2 dth2, drMx, drMy)`` (mm):
+zero offsets as lengths and the MAEMM, ``(L1 dth1, L2 dth2, drMx, drMy)``
+for the paper's robot, ``(L_i dth_i, drM)`` (m + n entries, mm) for any
+mechanism (:mod:`zerocal_sym.identify.linear`):
 
-    ds = G dp,   ds_k = s_k - (lambda_{k+1} - lambda_k),   G: (K-1) x 4,
+    ds = G dp,   ds_k = s_k - (lambda_{k+1} - lambda_k),   G: (K-1) x (m + n),
 
 solved by the truncated SVD ``dp = sum_{i<=t} (u_i^T ds / sigma_i) v_i``.
 
@@ -49,7 +51,6 @@ DEFAULT_RTOL = 1e-6
 RANK_RTOL = 1e-9
 #: poses whose second principal extent is below this fraction of the first are "on one line".
 COLLINEAR_RTOL = 1e-6
-PARAMS = ("theta1", "theta2", "rMx", "rMy")
 
 
 @dataclass
@@ -167,15 +168,16 @@ def tsvd_solve(G, b, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL, noise_std=Non
                         residual_norms=np.sqrt(res2), criterion=criterion)
 
 
-def _validate(meas, robot):
+def _validate(meas, robot, p):
     th = np.asarray(meas.theta_cmd, float)
     rd = np.asarray(meas.readings, float)
     K = th.shape[0]
-    if th.ndim != 2 or th.shape[1] != 2 or rd.shape != (K,):
-        raise IdentificationError(f"measurements must be theta_cmd (K, 2) and readings (K,), got {th.shape} "
-                                  f"and {rd.shape}", where=meas.source)
-    if K < 5:
-        raise IdentificationError(f"too few poses: K = {K} < 5 (4 parameters are identified from K - 1 "
+    if th.ndim != 2 or th.shape[1] != robot.m or rd.shape != (K,):
+        raise IdentificationError(f"measurements must be theta_cmd (K, {robot.m}) and readings (K,) for the "
+                                  f"{robot.m}-joint robot {robot.name!r}, got {th.shape} and {rd.shape}",
+                                  where=meas.source)
+    if K < p + 1:
+        raise IdentificationError(f"too few poses: K = {K} < {p + 1} ({p} parameters are identified from K - 1 "
                                   "measured changes)", where=meas.source)
     for name, arr in (("commanded joint angles", th), ("reading", rd)):
         bad = np.flatnonzero(~np.all(np.isfinite(arr.reshape(K, -1)), axis=1))
@@ -197,12 +199,12 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     ----------
     robot : Robot
     meas : Measurements
-        ``theta_cmd`` (K, 2) rad (compensation already applied), ``readings`` (K,) mm.
-    prior : ndarray, shape (12,), optional
+        ``theta_cmd`` (K, m) rad (compensation already applied), ``readings`` (K,) mm.
+    prior : ndarray, shape (q,), optional
         Current total source-error estimates (rad, mm; only the offsets and the
         MAEMM are used).  Default zero (the paper's first identification).
     t : int, optional
-        Fixed truncation level (1..4).
+        Fixed truncation level (1..m+n).
     rule : str
         Truncation rule (see :func:`tsvd_solve`); default ``threshold``.
     noise : NoiseModel, optional
@@ -214,7 +216,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     Returns
     -------
     IdentificationResult
-        ``method = "tsvd"``, params ``theta1 theta2 rMx rMy``.  ``covariance``
+        ``method = "tsvd"``, params: the zero offsets and the MAEMM.  ``covariance``
         is that of the linear TSVD estimator ``x = A b`` (``A = V_t S_t^-1
         U_t^T``) under the noise model, ``T A C A^T T`` with ``C`` the
         covariance of the measured changes (:func:`zerocal_sym.identify.fisher.
@@ -230,7 +232,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     Raises
     ------
     IdentificationError
-        K < 5, a non-finite reading or angle (naming the pose), G of rank < 4
+        K < m + n + 1, a non-finite reading or angle (naming the pose), G of rank < m + n
         (collinear measuring-mechanism vectors), poses on one straight line
         (G nearly rank-deficient, condition number ~1e4-1e5).
     PoseError
@@ -238,32 +240,36 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     """
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.identify.fisher import measurement_covariance
-    from zerocal_sym.paper.scheme import identification_matrix
+    from zerocal_sym.identify.linear import identification_matrix
 
-    _validate(meas, robot)
-    prior = np.zeros(12) if prior is None else np.asarray(prior, float)
-    if prior.shape != (12,) or not np.all(np.isfinite(prior)):
-        raise ValueError("prior must be a finite 12-vector of source errors")
+    errors = robot.errors
+    names = errors.resolve("offsets+measuring")
+    offs, maemm = errors.zero_offsets, errors.measuring
+    p = len(names)
+    _validate(meas, robot, p)
+    prior = errors.zeros() if prior is None else np.asarray(prior, float)
+    if prior.shape != (len(errors),) or not np.all(np.isfinite(prior)):
+        raise ValueError(f"prior must be a finite vector of the {len(errors)} source errors")
     th = np.asarray(meas.theta_cmd, float)
-    P = kin.fk(robot, th + prior[:2])
+    P = kin.fk(robot, th + errors.take(prior, offs))
     bad = np.flatnonzero(~np.all(np.isfinite(P), axis=1))
     if bad.size:
         k = int(bad[0])
         raise PoseError("commanded joint angles are not an assembly of the robot", where=meas.where(k))
-    G, lam = identification_matrix(robot, P, maemm_prior=prior[10:12])
+    G, lam = identification_matrix(robot, P, maemm_prior=errors.take(prior, maemm))
     b = np.asarray(meas.readings, float)[1:] - np.diff(lam)
     s = np.linalg.svd(G, compute_uv=False)
     if s[-1] <= RANK_RTOL * s[0]:
         rank = int(np.sum(s > RANK_RTOL * s[0]))
         raise IdentificationError(
-            f"identification matrix G has rank {rank} < 4: the measuring-mechanism vectors of the poses "
-            "are collinear, the offsets and the MAEMM cannot be identified", where=meas.source)
+            f"identification matrix G has rank {rank} < {p}: the measuring-mechanism vectors of the poses "
+            "are degenerate, the offsets and the MAEMM cannot be identified", where=meas.source)
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if spread[1] <= COLLINEAR_RTOL * spread[0]:
         raise IdentificationError(
             f"the {P.shape[0]} poses lie on one straight line: G is nearly rank-deficient (condition number "
-            f"{s[0] / s[-1]:.3g}); use poses that span the workspace (e.g. the paper's two boundaries)",
-            where=meas.source)
+            f"{s[0] / s[-1]:.3g}); use poses that span the workspace (e.g. the {robot.workspace.scheme_name} "
+            "scheme's two boundaries)", where=meas.source)
     C = None
     if noise is not None:
         C = measurement_covariance(robot, th, noise, err0=prior)
@@ -271,10 +277,10 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     if rule == "discrepancy" and t is None and noise_std is None:
         raise ValueError("rule='discrepancy' needs a noise model")
     sol = tsvd_solve(G, b, t=t, rule=rule, rtol=rtol, noise_std=noise_std)
-    L = robot.link_lengths
-    T = np.diag([1 / L[0], 1 / L[1], 1.0, 1.0])
+    # G's columns: offsets as lengths (lever * dtheta), then the MAEMM (mm)
+    T = np.diag(1.0 / robot.error_scale(names))
     inc = T @ sol.x
-    est = np.array([prior[0], prior[1], prior[10], prior[11]]) + inc
+    est = errors.take(prior, names) + inc
     lin_res = b - G @ sol.x
     A = T @ sol.operator()
     m = G.shape[0]
@@ -284,9 +290,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         cov = float(lin_res @ lin_res) / (m - sol.t) * (A @ A.T)
     else:
         cov = None
-    full = prior.copy()
-    full[[0, 1, 10, 11]] = est
-    full[2:10] = 0.0
+    full = errors.put(errors.zeros(), names, est)
     pred = np.diff(kin.distance(robot, th, full))
     residuals = np.asarray(meas.readings, float)[1:] - pred
     status = f"ok: TSVD t = {sol.t} of {s.size} ({sol.rule})"
@@ -302,7 +306,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         "increment": inc,
         "nominal_poses": P,
         "right_singular_vectors": sol.Vt,
-        "maemm_prior": prior[10:12].copy(),
+        "maemm_prior": errors.take(prior, maemm),
     }
-    return IdentificationResult(method="tsvd", params=PARAMS, estimate=est, covariance=cov, success=True,
-                                status=status, residuals=residuals, info=info)
+    return IdentificationResult(method="tsvd", params=names, estimate=est, covariance=cov, success=True,
+                                status=status, residuals=residuals, info=info, errors=errors)

@@ -13,9 +13,9 @@ import numpy as np
 from zerocal_sym.errors import PoseError
 
 
-def fmt_pose(p) -> str:
-    """``(x, y[, z])`` with ``%g`` numbers, for messages."""
-    return "(" + ", ".join(f"{v:g}" for v in p) + ")"
+def fmt_pose(p, spec: str = "g") -> str:
+    """``(x, y[, z])`` with ``%g`` numbers (or the format ``spec``, e.g. ``".3f"``), for messages."""
+    return "(" + ", ".join(format(float(v), spec) for v in p) + ")"
 
 
 def _cols(a, n):

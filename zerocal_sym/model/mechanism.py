@@ -64,6 +64,9 @@ class Mechanism:
     measuring_base, measuring_offset : list of str
         Geometry names of ``c`` and ``d``.
     gauge_names : list of str
+    gauge_fix : list of str
+        Source errors held at zero to fix the gauge (the rest of ``all`` is
+        identifiable from enough poses).
     workspace : str
         ``rectangle`` | ``cylinder``.
     aliases, defaults : dict
@@ -84,12 +87,16 @@ class Mechanism:
         self.joint_names = list(mod.JOINT_NAMES)
         self.geometry_names = list(mod.GEOMETRY_NAMES)
         self.geometry_units = dict(mod.GEOMETRY_UNITS)
-        self.errors = SourceErrors(mod.SOURCE_ERRORS, mod.PARAM_SETS)
+        names = [row[0] for row in mod.SOURCE_ERRORS]
+        # "gauge_fixed": every source error but those that fix the gauge (identifiable from enough poses)
+        self.errors = SourceErrors(mod.SOURCE_ERRORS, {
+            **mod.PARAM_SETS, "gauge_fixed": tuple(n for n in names if n not in mod.GAUGE_FIX)})
         self.source_error_names = list(self.errors.names)
         self.home_joints = np.array(mod.HOME_JOINTS, float)
         self.measuring_base = list(mod.MEASURING_BASE)
         self.measuring_offset = list(mod.MEASURING_OFFSET)
         self.gauge_names = list(mod.GAUGE_NAMES)
+        self.gauge_fix = list(mod.GAUGE_FIX)
         self.workspace = mod.WORKSPACE
         self.aliases = dict(mod.ALIASES)
         self.defaults = dict(mod.DEFAULTS)

@@ -324,9 +324,11 @@ def validate(robot: Robot, where=None) -> dict:
             return name
         return next((a for a, parts in mech.aliases.items() if name in parts), name)
 
+    links = set(mech.errors.extra_sets.get("lengths", ()))
     for key in mech.positive:
         if robot.param(key) <= 0:
-            raise RobotFileError(f"length {key} must be positive, got {robot.param(key):g}", where=where(key_of(key)))
+            what = "link length" if key in links else "length"
+            raise RobotFileError(f"{what} {key} must be positive, got {robot.param(key):g}", where=where(key_of(key)))
     for key in robot.workspace.sizes:
         v = getattr(robot.workspace, key)
         if v <= 0:

@@ -20,6 +20,8 @@ Parameter sets (:meth:`SourceErrors.resolve`)
     the paper's identification parameters (Eq. 28);
 ``all``
     every source error;
+``gauge_fixed``
+    every source error but those the mechanism holds at zero to fix the gauge;
 plus the mechanism's own sets (``lengths``, ``base``) and single names,
 combined with ``+`` or ``,`` (``offsets+measuring+L1,L2``).
 
@@ -184,7 +186,7 @@ class SourceErrors:
         maemm_mm : sequence of n floats, optional
         """
         v = self.vector(geometry or {})
-        for names, vals, conv in ((self.zero_offsets, zero_offsets_deg, np.radians), (self.measuring, maemm_mm, float)):
+        for names, vals, conv in ((self.zero_offsets, zero_offsets_deg, np.radians), (self.measuring, maemm_mm, np.asarray)):
             if vals is None:
                 continue
             vals = np.asarray(vals, float)

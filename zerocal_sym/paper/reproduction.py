@@ -18,35 +18,13 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import PoseError, ZerocalError
-# simulate_round: not used here, still reached as paper.simulate_round by identify/compare.py
-from zerocal_sym.identify.loop import calibration_loop, simulate_round  # noqa: F401
+from zerocal_sym.identify.loop import calibration_loop, home_error, position_errors, simulate_round
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-from zerocal_sym.paper.scheme import condition_number, identification_matrix, paper_poses
+from zerocal_sym.paper.scheme import paper_poses
+from zerocal_sym.identify.linear import condition_number, identification_matrix
 from zerocal_sym.paper.tables import (DEFAULT_MAEMM_PRIOR, PAPER_KAPPA_1, PAPER_KAPPA_M, PAPER_N, group_errors,
                                       paper_table, to_table_frame)
 from zerocal_sym.identify.tsvd import identify_tsvd
-
-
-# ---------------------------------------------------------------- evaluation
-def position_errors(robot, plant, poses, compensation_rad=(0.0, 0.0)) -> np.ndarray:
-    """``|P_actual - P|`` at nominal poses commanded as ``IK(P) - compensation``.
-
-    Exact forward kinematics of the actual robot (no noise).
-
-    Returns
-    -------
-    ndarray, shape (K,)
-        mm.
-    """
-    poses = np.atleast_2d(np.asarray(poses, float))
-    th = kin.ik(robot, poses) - np.asarray(compensation_rad, float)
-    return np.linalg.norm(plant.actual_pose(th) - poses, axis=1)
-
-
-def home_error(robot, plant, compensation_rad=(0.0, 0.0)) -> float:
-    """``dp0``: distance from P0 of the platform commanded to home (minus the compensation), mm."""
-    th = robot.home_joints()[None, :] - np.asarray(compensation_rad, float)
-    return float(np.linalg.norm(plant.actual_pose(th)[0] - robot.home_pose()))
 
 
 # ---------------------------------------------------------------- pose scheme

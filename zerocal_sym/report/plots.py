@@ -192,7 +192,7 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
         ``compensation_deg`` (2,).
     """
     from zerocal_sym.model.noise import VirtualPlant
-    from zerocal_sym.paper.reproduction import position_errors
+    from zerocal_sym.identify.loop import position_errors
 
     P = boundary_positions(robot, K) if P is None else np.atleast_2d(np.asarray(P, float))
     comp = np.radians(np.asarray(compensation_deg, float))
