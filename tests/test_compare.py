@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from zerocal_sym.cli import main
-from zerocal_sym.identify.compare import METHODS, Progress, compare, format_compare, scipy_identify
+from zerocal_sym.identify.montecarlo import METHODS, Progress, format_compare, scipy_identify
+from zerocal_sym.paper.compare import compare
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import ZerocalError

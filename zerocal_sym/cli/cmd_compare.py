@@ -51,7 +51,8 @@ def add_arguments(p):
 
 def run(args):
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.identify.compare import Progress, compare, format_compare
+    from zerocal_sym.identify.montecarlo import Progress, format_compare
+    from zerocal_sym.paper.compare import compare
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.io.files import to_json, write_json
     from zerocal_sym.model.noise import NoiseModel
@@ -72,9 +73,7 @@ def run(args):
         poses = load_poses(args.poses, robot)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     try:
-        from zerocal_sym.identify.fisher import param_names
-
-        params = param_names(args.params)
+        params = robot.errors.resolve(args.params)
     except ValueError as exc:
         raise ZerocalError(f"--params: {exc}") from None
     total = args.trials * len(groups)

@@ -1,10 +1,12 @@
 """Monte Carlo comparison of the identification methods on the same simulated data.
 
-Per trial (one seed per group and trial), the first measurement round is
-simulated once; every method sees exactly that round first:
+For any mechanism: given the true source errors (one or more labelled
+*truths*) and the measurement poses, per trial (one seed per truth and trial)
+the first measurement round is simulated once; every method sees exactly that
+round first:
 
 * ``tsvd-loop``  -- the paper's procedure: TSVD identification inside the
-  compensation loop (:func:`zerocal_sym.paper.calibration_loop`), stopping at
+  compensation loop (:func:`zerocal_sym.identify.loop.calibration_loop`), stopping at
   the first ``mu < mu0``;
 * ``tsvd``       -- the first TSVD identification of that loop alone;
 * ``nlls``       -- Ipopt on the exact model, one shot, on the first round;
@@ -19,8 +21,9 @@ simulated once; every method sees exactly that round first:
 
 The loops draw their later rounds from the same seed, so the loop methods
 share the first round but not (after their compensations differ) the later
-ones.  Errors are reported in Table 2's frame (``frame="paper"``, as
-``zerocal reproduce``; RMS values do not depend on the frame).
+ones.  Errors are reported in our frame, or through a ``report`` transform
+(the paper's Table 2 frame: :func:`zerocal_sym.paper.compare.compare`; RMS
+values do not depend on the frame).
 """
 from __future__ import annotations
 
@@ -32,6 +35,7 @@ import numpy as np
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
+from zerocal_sym.identify.loop import calibration_loop, home_error, simulate_round
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 
 METHODS = ("tsvd-loop", "tsvd", "nlls", "nlls-loop", "nlls-seq", "scipy")
@@ -112,8 +116,8 @@ def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
 
     least_squares = _scipy_least_squares()
     fun, jac, scale = residual_problem(robot, meas, params, noise, prior)
-    p0 = np.zeros(12) if prior is None else np.asarray(prior, float)
-    z0 = p0[fisher.param_indices(params)] * scale
+    p0 = robot.errors.zeros() if prior is None else np.asarray(prior, float)
+    z0 = robot.errors.take(p0, robot.errors.resolve(params)) * scale
     t = time.perf_counter()
     sol = least_squares(fun, z0, jac=jac, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
     dt = time.perf_counter() - t
@@ -128,39 +132,46 @@ def _stats(E):
     return np.mean(E, axis=0), np.sqrt(np.mean(E**2, axis=0))
 
 
-def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", noise: NoiseModel | None = None,
-            seed: int = 0, frame: str = "paper", methods=METHODS, mu0_deg: float = 0.1, max_iter: int = 20,
-            progress=None, geometric: bool = True) -> dict:
+def _identity_report(values, which):
+    return np.asarray(values, float)
+
+
+def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise: NoiseModel | None = None,
+            seed: int = 0, methods=METHODS, mu0_deg: float = 0.1, max_iter: int = 20,
+            progress=None, report=None, settings=None) -> dict:
     """Run the Monte Carlo comparison.
 
     Parameters
     ----------
     robot : Robot
-    groups : sequence of int
-        Table 2 groups (1..6), read in ``frame``.
+    truths : dict of label -> ndarray, shape (q,)
+        The true source errors (rad, mm) of each study; the label keys the
+        output (``rep["groups"][str(label)]``).  Seeds are ``(seed, label, trial)``
+        for an integer label, ``(seed, index, trial)`` otherwise.
+    poses : ndarray, shape (K, n)
+        Measurement poses in visiting order.
     trials : int
-        Trials per group.
-    poses : ndarray, shape (K, 2), optional
-        Measurement poses in visiting order (default: the paper's 6).
+        Trials per truth.
     params : str or sequence of str
-        Parameters of the Ipopt methods (TSVD always has the paper's 4).
+        Parameters of the Ipopt methods (TSVD always has the zero offsets and the MAEMM).
     noise : NoiseModel, optional
         Simulation noise and the weights of Ipopt (default: the paper's).
     seed : int
-    frame : {"paper", "literal"}
     methods : sequence of str
         A subset of :data:`METHODS`.
     mu0_deg, max_iter : loop settings.
-    geometric : bool
-        Keep Table 2's geometric errors in the plant (False: only offsets and MAEMM,
-        so the 4-parameter model is exact).
     progress : callable, optional
         ``progress(done)`` after each trial.
+    report : callable, optional
+        ``report(values, which)`` with ``which`` ``"offsets"`` (deg, m) or
+        ``"maemm"`` (mm, n): how errors are reported (default: as they are).
+    settings : dict, optional
+        Extra entries for ``rep["settings"]``.
 
     Returns
     -------
     dict
-        ``settings``, ``crlb_zero_offsets_deg`` (per group, at the truth and the
+        ``settings``, ``crlb_zero_offsets_deg`` (per truth, at the truth and the
         first round's poses), and per group and method: ``bias_deg``,
         ``rms_deg``, ``rms_crlb_ratio`` (zero offsets), ``bias_maemm_mm``,
         ``rms_maemm_mm``, ``dp0_rms_mm`` / ``dp0_mean_mm`` / ``dp0_max_mm``
@@ -170,10 +181,14 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
         (per trial, mean), ``time_per_identification_ms``; ``scipy``:
         ``max_abs_diff_to_ipopt_deg`` and the time ratio.
     """
-    from zerocal_sym.paper import reproduction as paper
     from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
-    from zerocal_sym.paper.scheme import paper_poses
     from zerocal_sym.identify.tsvd import identify_tsvd
+
+    report = report or _identity_report
+    errors = robot.errors
+    offs, meas_names = errors.zero_offsets, errors.measuring
+    paper4 = errors.resolve("offsets+measuring")
+    m_ = len(offs)
 
     noise = NoiseModel.paper() if noise is None else noise
     unknown = [m for m in methods if m not in METHODS]
@@ -181,27 +196,30 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
         raise ZerocalError(f"unknown method(s) {', '.join(unknown)} (known: {', '.join(METHODS)})")
     if "scipy" in methods:
         _scipy_least_squares()
-    names = fisher.param_names(params)
-    if "theta1" not in names or "theta2" not in names:
-        raise ZerocalError("the parameter set must contain theta1 and theta2")
-    poses = paper_poses(robot, 3) if poses is None else np.atleast_2d(np.asarray(poses, float))
+    try:
+        names = errors.resolve(params)
+    except ValueError as exc:
+        raise ZerocalError(str(exc)) from None
+    if any(n not in names for n in offs):
+        raise ZerocalError(f"the parameter set must contain the zero offsets {', '.join(offs)}")
+    poses = np.atleast_2d(np.asarray(poses, float))
     th0 = kin.check_poses(robot, poses)
     K = poses.shape[0]
     if K - 1 < len(names):
         raise ZerocalError(f"{K} poses give {K - 1} measured changes: fewer than the {len(names)} parameters")
-    out = {"settings": {"groups": list(groups), "trials": trials, "K": K, "poses_mm": poses.tolist(),
+    out = {"settings": {"mechanism": robot.mechanism_name, "groups": [str(g) for g in truths], "trials": trials,
+                        "K": K, "poses_mm": poses.tolist(),
                         "params": list(names), "noise": {"sigma_scale_mm": noise.sigma_scale_mm,
                                                          "sigma_servo_rad": noise.sigma_servo_rad},
-                        "seed": seed, "frame": frame, "methods": list(methods), "mu0_deg": mu0_deg,
-                        "max_iter": max_iter, "geometric_errors": bool(geometric), "error_frame": "Table 2's" if frame == "paper" else "ours"},
+                        "seed": seed, "methods": list(methods), "mu0_deg": mu0_deg,
+                        "max_iter": max_iter, "error_frame": "ours", **(settings or {})},
            "groups": {}}
     done = 0
-    for g in groups:
-        err = paper.group_errors(g, frame)
-        if not geometric:
-            err[2:10] = 0.0
+    for gi, (g, err) in enumerate(truths.items()):
+        err = errors.check_vector(err, f"truth {g!r}")
         plant = VirtualPlant(robot, err)
-        true4 = err[[0, 1, 10, 11]]
+        true4 = errors.take(err, paper4)
+        stream = g if isinstance(g, int) else gi
         try:
             crlb = fisher.crlb_zero_offsets_deg(robot, th0, names, noise, err0=err) if not noise.is_zero else None
         except ZerocalError:
@@ -209,8 +227,8 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
         rec = {m: {"E": [], "M": [], "dp0": [], "fail": 0, "nc": 0, "nid": 0, "t": 0.0} for m in methods}
         sc_diff, sc_t, ip_t = [], [], []
         for trial in range(trials):
-            ss = np.random.SeedSequence([seed, g, trial])
-            meas1 = paper.simulate_round(robot, plant, poses, (0.0, 0.0), noise, np.random.default_rng(ss))
+            ss = np.random.SeedSequence([seed, stream, trial])
+            meas1 = simulate_round(robot, plant, poses, None, noise, np.random.default_rng(ss))
 
             def record(m, est4, t, n_ident=1, converged=True):
                 r = rec[m]
@@ -221,9 +239,9 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
                     return
                 r["nc"] += 0 if converged else 1
                 e = est4 - true4
-                r["E"].append(paper.to_table_frame(np.degrees(e[:2]), frame, "offsets"))
-                r["M"].append(paper.to_table_frame(e[2:], frame, "maemm"))
-                r["dp0"].append(paper.home_error(robot, plant, est4[:2]))
+                r["E"].append(report(np.degrees(e[:m_]), "offsets"))
+                r["M"].append(report(e[m_:], "maemm"))
+                r["dp0"].append(home_error(robot, plant, est4[:m_]))
 
             for m in ("tsvd-loop", "nlls-loop", "nlls-seq"):
                 if m not in methods and not (m == "tsvd-loop" and "tsvd" in methods):
@@ -231,8 +249,8 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
                 ident = _Timed(identify_tsvd if m == "tsvd-loop" else
                                make_nlls_identifier(params=names, noise=noise, sequential=(m == "nlls-seq")))
                 try:
-                    loop = paper.calibration_loop(robot, plant, poses, identify=ident, noise=noise,
-                                                  rng=np.random.default_rng(ss), mu0_deg=mu0_deg, max_iter=max_iter)
+                    loop = calibration_loop(robot, plant, poses, identify=ident, noise=noise,
+                                            rng=np.random.default_rng(ss), mu0_deg=mu0_deg, max_iter=max_iter)
                 except (IdentificationError, ZerocalError):
                     loop = None
                 if m == "tsvd-loop" and "tsvd" in methods:
@@ -240,8 +258,7 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
                     if first is None or not first.success:
                         record("tsvd", None, 0.0)
                     else:
-                        record("tsvd", np.array([first.value(n) for n in ("theta1", "theta2", "rMx", "rMy")]),
-                               ident.t / max(1, ident.n))
+                        record("tsvd", np.array([first.value(n) for n in paper4]), ident.t / max(1, ident.n))
                 if m not in methods:
                     continue
                 if loop is None:
@@ -253,26 +270,25 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
                 t = time.perf_counter()
                 res = identify_nlls(robot, meas1, names, noise=noise)
                 dt = time.perf_counter() - t
-                est = (np.array([res.value(n) for n in ("theta1", "theta2", "rMx", "rMy")])
-                       if res.success else None)
+                est = np.array([res.value(n) for n in paper4]) if res.success else None
                 if "nlls" in methods:
                     record("nlls", est, dt)
             if "scipy" in methods:
                 ref = identify_nlls(robot, meas1, names, noise=noise, warm_start=None, reweight=0)
                 p_sc, info = scipy_identify(robot, meas1, names, noise)
                 ok = info["success"] and ref.success
-                record("scipy", np.array([p_sc[names.index(n)] if n in names else 0.0
-                                          for n in ("theta1", "theta2", "rMx", "rMy")]) if ok else None,
+                record("scipy", np.array([p_sc[names.index(n)] if n in names else 0.0 for n in paper4]) if ok else None,
                        info["time_s"])
                 if ok:
-                    sc_diff.append(np.max(np.abs(np.degrees(p_sc[:2] - ref.estimate[:2]))))
+                    pos = [names.index(n) for n in offs]
+                    sc_diff.append(np.max(np.abs(np.degrees(p_sc[pos] - ref.estimate[pos]))))
                     sc_t.append(info["time_s"])
                     ip_t.append(ref.info["time_s"])
             done += 1
             if progress:
                 progress(done)
         gout = {"crlb_zero_offsets_deg": None if crlb is None else np.asarray(crlb).tolist(),
-                "set_deg": paper.to_table_frame(np.degrees(err[:2]), frame, "offsets").tolist(),
+                "set_deg": report(np.degrees(errors.take(err, offs)), "offsets").tolist(),
                 "methods": {}}
         for m in methods:
             r = rec[m]
@@ -307,30 +323,37 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, params="paper", n
     return out
 
 
+def _vec(v, fmt):
+    return ",".join(format(x, fmt) for x in v)
+
+
 def format_compare(rep: dict) -> str:
-    """The comparison as text tables."""
+    """The comparison as text tables (one column group per zero offset and MAEMM component)."""
     s = rep["settings"]
     lines = [f"Monte Carlo: {s['trials']} trials per group, K = {s['K']} poses, Ipopt parameters "
              f"{', '.join(s['params'])}, noise scale {s['noise']['sigma_scale_mm'] * 1e3:.4g} um, servo "
-             f"{np.degrees(s['noise']['sigma_servo_rad']):.4g} deg, seed {s['seed']}; geometric errors "
-             f"{'on' if s['geometric_errors'] else 'off'}; errors in {s['error_frame']} frame"]
+             f"{np.degrees(s['noise']['sigma_servo_rad']):.4g} deg, seed {s['seed']}"
+             + (f"; geometric errors {'on' if s['geometric_errors'] else 'off'}" if "geometric_errors" in s else "")
+             + f"; errors in {s['error_frame']} frame"]
     for g, go in rep["groups"].items():
         cr = go["crlb_zero_offsets_deg"]
+        m = len(go["set_deg"])
         lines.append("")
-        lines.append(f"group {g}: set offsets {go['set_deg'][0]:+.3f}, {go['set_deg'][1]:+.3f} deg;  CRLB "
-                     + ("n/a" if cr is None else f"{cr[0]:.4f}, {cr[1]:.4f} deg"))
-        lines.append(f"  {'method':10s} {'bias dth1,dth2 [deg]':>22s} {'RMS dth1,dth2 [deg]':>21s} "
-                     f"{'RMS/CRLB':>13s} {'RMS rM [mm]':>15s} {'dp0 RMS':>8s} {'fail':>4s} {'noconv':>6s} "
-                     f"{'ident':>5s} {'ms/ident':>8s}")
-        for m, r in go["methods"].items():
+        lines.append(f"group {g}: set offsets {_vec(go['set_deg'], '+.3f')} deg;  CRLB "
+                     + ("n/a" if cr is None else f"{_vec(cr, '.4f')} deg"))
+        offs = ",".join(f"dth{k + 1}" for k in range(m))
+        w = 11 * m
+        lines.append(f"  {'method':10s} {'bias ' + offs + ' [deg]':>{w}s} {'RMS ' + offs + ' [deg]':>{w}s} "
+                     f"{'RMS/CRLB':>{6 * m + 1}s} {'RMS rM [mm]':>{8 * m}s} {'dp0 RMS':>8s} {'fail':>4s} "
+                     f"{'noconv':>6s} {'ident':>5s} {'ms/ident':>8s}")
+        for name, r in go["methods"].items():
             if r["rms_deg"] is None:
-                lines.append(f"  {m:10s} all {r['failures']} trials failed")
+                lines.append(f"  {name:10s} all {r['failures']} trials failed")
                 continue
-            ratio = "n/a" if r["rms_crlb_ratio"] is None else f"{r['rms_crlb_ratio'][0]:.3f},{r['rms_crlb_ratio'][1]:.3f}"
+            ratio = "n/a" if r["rms_crlb_ratio"] is None else _vec(r["rms_crlb_ratio"], ".3f")
             nc = "-" if r["not_converged"] is None else str(r["not_converged"])
-            lines.append(f"  {m:10s} {r['bias_deg'][0]:+10.4f},{r['bias_deg'][1]:+10.4f} "
-                         f"{r['rms_deg'][0]:10.4f},{r['rms_deg'][1]:10.4f} {ratio:>13s} "
-                         f"{r['rms_maemm_mm'][0]:7.4f},{r['rms_maemm_mm'][1]:7.4f} {r['dp0_rms_mm']:8.4f} "
+            lines.append(f"  {name:10s} {_vec(r['bias_deg'], '+10.4f'):>{w}s} {_vec(r['rms_deg'], '10.4f'):>{w}s} "
+                         f"{ratio:>{6 * m + 1}s} {_vec(r['rms_maemm_mm'], '7.4f'):>{8 * m}s} {r['dp0_rms_mm']:8.4f} "
                          f"{r['failures']:4d} {nc:>6s} {r['identifications']:5.1f} "
                          f"{r['time_per_identification_ms']:8.2f}")
         sr = go.get("scipy_reference")
