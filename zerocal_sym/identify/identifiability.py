@@ -82,37 +82,46 @@ def _combination(robot, names, v, scale, tol=1e-3):
     return terms
 
 
-def _gauge_labels(robot, names, scale, null, err0):
-    """Which declared gauge motions the null space is made of.
+def _gauge_in_params(robot, names, scale, err0):
+    """The declared gauge motions that are invisible in these parameters (all components estimated).
 
-    Returns ``(all_gauge, per_direction)``: True if every null direction lies
-    in the span of the gauge motions whose components are all estimated;
-    per null direction the names of the gauge motions that make it up (empty
-    if it is not a gauge motion).
+    Returns ``(labels, Z)`` with ``Z`` shape (p, z') in scaled units.
     """
-    if not null.size:
-        return None, []
-    errors = robot.errors
-    idx = errors.indices(names)
+    idx = robot.errors.indices(names)
     gens, labels = [], []
     for label, g in zip(robot.mechanism.gauge_names, gauge_generators(robot, err0)):
-        # a gauge motion is invisible in these parameters only if all its components are estimated
         if np.all(np.isin(np.flatnonzero(np.abs(g) > 1e-12), idx)):
             gens.append(g[idx] * scale)
             labels.append(label)
-    if not gens:
-        return False, [[] for _ in null]
-    Z = np.array(gens).T                                   # (p, z) scaled units
+    return labels, (np.array(gens).T if gens else np.zeros((len(names), 0)))
+
+
+def _null_space_named(robot, names, scale, null, err0):
+    """The null space written, where it can be, as the declared gauge motions.
+
+    Returns ``(rigid, vectors, labels)``: ``rigid`` True if the null space is
+    exactly spanned by the gauge motions invisible in these parameters (then
+    ``vectors`` are those motions, one per null direction, each labelled
+    with its name), False if not (``vectors`` the SVD basis, each labelled
+    with the gauge motions it lies in, or none), None without a null space.
+    """
+    if not null.size:
+        return None, null, []
+    labels, Z = _gauge_in_params(robot, names, scale, err0)
+    if Z.shape[1]:
+        Qg, _ = np.linalg.qr(Z)
+        in_span = bool(np.allclose(null.T - Qg @ (Qg.T @ null.T), 0.0, atol=1e-6))
+        if in_span and Z.shape[1] == null.shape[0]:
+            return True, Z.T, [[lab] for lab in labels]
     per = []
     for v in null:
+        if not Z.shape[1]:
+            per.append([])
+            continue
         coef, *_ = np.linalg.lstsq(Z, v, rcond=None)
         inside = np.linalg.norm(Z @ coef - v) < 1e-6 * max(1.0, np.linalg.norm(v))
-        big = np.abs(coef) > 1e-6 * np.max(np.abs(coef)) if inside else np.zeros(len(labels), bool)
-        per.append([lab for lab, b in zip(labels, big) if b])
-    # the span as a whole (a null basis vector may mix gauge motions)
-    Qg, _ = np.linalg.qr(Z)
-    span_ok = bool(np.allclose(null.T - Qg @ (Qg.T @ null.T), 0.0, atol=1e-6))
-    return span_ok, per
+        per.append([lab for lab, c in zip(labels, coef) if inside and abs(c) > 1e-6 * np.max(np.abs(coef))])
+    return False, null, per
 
 
 def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel | None = None,
@@ -139,9 +148,10 @@ def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel |
         (whitened & scaled), ``condition_number``, ``scaling`` (text),
         ``directions``: for each singular value its combination (weights on
         the scaled parameters, largest 1) and ``std_mm = 1/sigma``;
-        ``null_space``: the combinations with ``sigma < rtol sigma_max``;
-        ``null_space_gauge``: for each null combination, the declared gauge
-        motions it is made of (empty: not a gauge motion);
+        ``null_space``: the combinations with ``sigma < rtol sigma_max`` --
+        the declared gauge motions themselves when they span it exactly;
+        ``null_space_gauge``: for each null combination, the names of the
+        gauge motions it is made of (empty: not a gauge motion);
         ``null_space_rigid``: True if the whole null space is spanned by the
         gauge motions (None if there is no null space);
         ``identifiable``: per parameter, whether it is orthogonal to the null
@@ -164,7 +174,7 @@ def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel |
     rank = int(np.sum(sv > rtol * smax)) if smax > 0 else 0
     null = Vt[rank:]
     ident = [bool(null.size == 0 or np.max(np.abs(null[:, k])) < 1e-6) for k in range(p)]
-    rigid, per = _gauge_labels(robot, names, scale, null, err0)
+    rigid, null_vectors, per = _null_space_named(robot, names, scale, null, err0)
     crlb_std = [None] * p
     if not noise.is_zero and rank:
         Finv = (Vt[:rank].T / sv[:rank] ** 2) @ Vt[:rank]
@@ -186,7 +196,7 @@ def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel |
                     + ("unweighted (mm)" if noise.is_zero else "whitened by chol(Cov(s)) (paper noise model "
                        "unless given), so 1/sigma is the std (mm) of that combination")),
         "directions": directions,
-        "null_space": [d["combination"] for d in directions[rank:]],
+        "null_space": [_combination(robot, names, v, scale) for v in null_vectors],
         "null_space_gauge": per,
         "null_space_rigid": rigid,
         "gauge_fix": list(robot.mechanism.gauge_fix),
