@@ -199,3 +199,13 @@ def test_generated_functions_match_sympy(mrobot, symbolic, rng):
             for w, o in zip(want, got):
                 np.testing.assert_allclose(o.full(), np.asarray(w, float).reshape(o.shape), rtol=1e-9, atol=1e-9,
                                            err_msg=fname)
+
+
+def test_delta_md_numbers_reproduce():
+    """examples/delta_numbers.py checks every number shared/DELTA.md reports (exit 0 = all reproduce)."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, str(EXAMPLES / "delta_numbers.py")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "BAD" not in r.stdout and r.stdout.count("ok ") >= 12
