@@ -52,14 +52,14 @@ def make_example():
                          "(examples/make_measurements_example.py)",
             "true_zero_offsets_deg": " ".join(f"{v:.10g}" for v in np.degrees(err[:2])),
             "true_maemm_mm": " ".join(f"{v:.10g}" for v in err[10:12])}
-    return Measurements(theta, readings, P, meta)
+    return Measurements(theta, readings, P, meta, mechanism=robot.mechanism_name)
 
 
 def main():
     meas = make_example()
     data.write_measurements(HERE / "measurements_example.csv", meas)
     text = "# target positions for 'zerocal compensate --poses' (the paper's six poses), mm\npose,x_mm,y_mm\n"
-    text += "".join(f"{k},{x:g},{y:g}\n" for k, (x, y) in enumerate(meas.target))
+    text += "".join(f"{k}," + ",".join(f"{v:g}" for v in p) + "\n" for k, p in enumerate(meas.target))
     atomic_write_text(HERE / "poses_example.csv", text)
 
 

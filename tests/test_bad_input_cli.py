@@ -133,8 +133,9 @@ def test_data_of_another_robot(capsys, tmp_path):
     r = tmp_path / "other.toml"
     r.write_text(toml)
     p = data_file(tmp_path, EXAMPLE)
+    sha_line = next(i for i, ln in enumerate(LINES, 1) if ln.startswith("# robot_sha256:"))
     check_error(capsys, tmp_path, ["identify", str(p), "--robot", str(r)], r"measured on another robot",
-                where=f"{p}:2")
+                where=f"{p}:{sha_line}")
 
 
 def test_bom_and_crlf_are_accepted(capsys, tmp_path):

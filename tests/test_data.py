@@ -24,7 +24,7 @@ from zerocal_sym.paper.tables import table2_errors
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "measurements_example.csv"
 HEADER = "pose,theta1_deg,theta2_deg,reading_mm,x_mm,y_mm"
-HL = 3  # header line of the files written by format_measurements(good_meas)
+HL = 4  # header line of the files written by format_measurements(good_meas): format, mechanism, robot_sha256
 
 
 @pytest.fixture(scope="module")
@@ -96,6 +96,9 @@ def test_round_trip_exact(tmp_path, good_meas, robot):
     assert m.meta["robot_sha256"] == robot.sha256
     assert m.K == 6 and m.changes.shape == (5,)
     assert m.lines == [data_line(p.read_text(), k) for k in range(6)]
+    assert lines_of(p.read_text())[:HL] == [data.FORMAT_LINE, "# mechanism: planar_2dof",
+                                            f"# robot_sha256: {robot.sha256}", HEADER]
+    assert m.mechanism == "planar_2dof" and m.meta_lines["mechanism"] == 2
 
 
 def test_without_targets_and_any_column_order(tmp_path, good_meas, robot):
@@ -349,7 +352,7 @@ def test_swapped_target_columns(tmp_path, good_text, robot):
 
 def test_robot_hash_mismatch(tmp_path, good_text, robot):
     text = good_text.replace(robot.sha256, "0" * 64)
-    expect(tmp_path, text, r"measured on another robot", line=2, robot=robot)
+    expect(tmp_path, text, r"measured on another robot", line=HL - 1, robot=robot)
 
 
 # --------------------------------------------------------------------------- bad input: the file itself

@@ -11,6 +11,7 @@ from zerocal_sym.io.poses import load_poses
 from zerocal_sym.io.results import load_result
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.model.measurements import Measurements
+from zerocal_sym.model.mechanism import get_mechanism
 from zerocal_sym.model.robot import paper_robot
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -27,9 +28,10 @@ def check_measurements(m):
     assert isinstance(m, Measurements)
     K = m.K
     assert K >= data.MIN_POSES
-    assert m.theta_cmd.shape == (K, 2) and np.all(np.isfinite(m.theta_cmd))
+    mech = get_mechanism(m.mechanism)  # the file's, the robot's or the one its columns are
+    assert m.theta_cmd.shape == (K, mech.m) and np.all(np.isfinite(m.theta_cmd))
     assert m.readings.shape == (K,) and np.all(np.isfinite(m.readings)) and m.readings[0] == 0
-    assert m.target is None or (m.target.shape == (K, 2) and np.all(np.isfinite(m.target)))
+    assert m.target is None or (m.target.shape == (K, mech.n) and np.all(np.isfinite(m.target)))
     assert len(m.lines) == K and m.lines == sorted(set(m.lines))
 
 
@@ -41,6 +43,8 @@ def load_both(path):
             assert "\n" not in str(exc) and str(exc).startswith(str(path))
         else:
             check_measurements(m)
+            if robot is not None:
+                assert m.mechanism == robot.mechanism_name
 
 
 @FUZZ
@@ -132,7 +136,9 @@ def test_result_loader(tmp_path, text):
         r = load_result(p)
     except DataFileError:
         return
-    assert r.zero_offsets_deg.shape == (2,) and np.all(np.isfinite(r.zero_offsets_deg))
+    mech = get_mechanism(r.mechanism)
+    assert r.zero_offsets_deg.shape == (mech.m,) and np.all(np.isfinite(r.zero_offsets_deg))
+    assert r.maemm_mm.shape == (mech.n,) and r.std_zero_offsets_deg.shape == (mech.m,)
 
 
 @FUZZ

@@ -8,6 +8,13 @@ separator is a comma; ``#`` starts a comment line; blank lines are ignored; a
 UTF-8 byte-order mark is accepted.  Every error is a
 :class:`~zerocal_sym.errors.DataFileError` naming the file, the line and,
 where there is one, the column (by name and field number).
+
+The columns of the data files come from the robot's mechanism
+(:func:`joint_columns`, :func:`pose_columns`): ``theta1_deg, theta2_deg[,
+theta3_deg]`` from its joint names, ``x_mm, y_mm[, z_mm]`` from its pose
+names.  A file read without a robot is matched to the registered mechanism
+whose columns it has (:func:`infer_mechanism`), the default mechanism if none
+fits (so the messages name the columns a planar file needs).
 """
 from __future__ import annotations
 
@@ -19,6 +26,9 @@ import re
 from pathlib import Path
 
 from zerocal_sym.errors import DataFileError
+
+#: metadata key naming the mechanism a file belongs to (``# mechanism: delta_rotary``)
+MECHANISM_KEY = "mechanism"
 
 #: plausibility limits of the cells (anything beyond is a unit or typing error)
 ANGLE_LIMIT_DEG = 3600.0
@@ -196,3 +206,92 @@ def _load_json(text: str, src: str):
 def _json_line(text: str, key: str):
     m = re.search(rf'"{re.escape(key)}"\s*:', text)
     return text.count("\n", 0, m.start()) + 1 if m else None
+
+
+# --------------------------------------------------------------------------- columns from the mechanism
+
+def get_mechanism_of(spec=None):
+    """The :class:`~zerocal_sym.model.mechanism.Mechanism` of ``spec``.
+
+    Parameters
+    ----------
+    spec : str, Mechanism, Robot or None
+        A registered name, a mechanism, a robot (its mechanism), or None for
+        the default mechanism.
+
+    Raises
+    ------
+    ValueError
+        An unknown mechanism name.
+    """
+    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, REGISTRY, Mechanism, get_mechanism
+
+    if spec is None:
+        return get_mechanism(DEFAULT_MECHANISM)
+    if isinstance(spec, Mechanism):
+        return spec
+    if not isinstance(spec, str):
+        return spec.mechanism
+    if spec not in REGISTRY:
+        raise ValueError(f"unknown mechanism {spec!r} (known: {', '.join(REGISTRY)})")
+    return get_mechanism(spec)
+
+
+def registered_mechanisms() -> list:
+    """Every registered mechanism, the default first."""
+    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, REGISTRY, get_mechanism
+
+    return [get_mechanism(k) for k in sorted(REGISTRY, key=lambda k: k != DEFAULT_MECHANISM)]
+
+
+def joint_columns(mech, suffix: str = "_deg") -> tuple:
+    """``theta1_deg, ...``: one column per joint of ``mech`` (a name, Mechanism or Robot)."""
+    return tuple(j + suffix for j in get_mechanism_of(mech).joint_names)
+
+
+def pose_columns(mech) -> tuple:
+    """``x_mm, y_mm[, z_mm]``: one column per pose coordinate of ``mech`` (a name, Mechanism or Robot)."""
+    return tuple(p + "_mm" for p in get_mechanism_of(mech).pose_names)
+
+
+def infer_mechanism(header, joints: bool = True):
+    """The registered mechanism whose columns ``header`` has, else the default.
+
+    Parameters
+    ----------
+    header : sequence of str
+    joints : bool
+        Match the joint columns first (measurement files), then the pose
+        columns; with False only the pose columns (pose lists).
+
+    Returns
+    -------
+    Mechanism
+    """
+    mechs = registered_mechanisms()
+    h = set(header)
+    cands = mechs
+    for cols_of in ((joint_columns, pose_columns) if joints else (pose_columns,)):
+        present = h & set().union(*(cols_of(x) for x in mechs))
+        fit = [x for x in cands if set(cols_of(x)) == present]
+        if not fit and cols_of is pose_columns and not present:
+            fit = cands  # targets are optional
+        if not fit:
+            break
+        cands = fit
+        if len(cands) == 1:
+            break
+    return cands[0]
+
+
+def mechanism_for_shape(m: int | None = None, n: int | None = None):
+    """The one registered mechanism with m joints and n pose coordinates (None: any), or None."""
+    fit = [x for x in registered_mechanisms() if (m is None or x.m == m) and (n is None or x.n == n)]
+    return fit[0] if len(fit) == 1 else None
+
+
+def _go_together(names) -> str:
+    """``columns x_mm and y_mm go together (both or neither)`` (``all or none`` for three or more)."""
+    names = list(names)
+    text = ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+    return f"columns {text} go together ({'both or neither' if len(names) == 2 else 'all or none'})"

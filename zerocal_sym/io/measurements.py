@@ -2,9 +2,11 @@
 
 Measurement file
 ----------------
-One row per measurement pose, in the order the robot visited them::
+One row per measurement pose, in the order the robot visited them; the
+columns come from the robot's mechanism (here the planar robot's)::
 
     # zerocal measurements v1
+    # mechanism: planar_2dof             (written by zerocal; optional)
     # robot_sha256: 2eaac3c7...          (optional "# key: value" metadata)
     pose,theta1_deg,theta2_deg,reading_mm,x_mm,y_mm
     0,22.7339158,207.8070466,0,-240,632
@@ -12,12 +14,18 @@ One row per measurement pose, in the order the robot visited them::
     ...
 
 * ``pose``: 0, 1, ..., K-1 (the order matters: the scale measures changes).
-* ``theta1_deg, theta2_deg``: the joint angles the controller *commanded*
-  (nominal inverse kinematics minus any compensation already applied), deg.
+* ``theta1_deg, ..., thetam_deg`` (the mechanism's joint names + ``_deg``):
+  the joint angles the controller *commanded* (nominal inverse kinematics
+  minus any compensation already applied), deg.
 * ``reading_mm``: the linear scale's reading at this pose; the reading head is
   reset after each reading, so it is the change of the measuring-mechanism
   length since the previous pose; 0 at pose 0.
-* ``x_mm, y_mm`` (optional, both or neither): the nominal target position.
+* ``x_mm, y_mm[, z_mm]`` (the mechanism's pose names + ``_mm``; optional, all
+  or none): the nominal target position.
+* ``# mechanism: NAME``: the mechanism measured.  A file without it is read as
+  the mechanism of the robot it is checked against, or (no robot) as the
+  registered mechanism whose columns it has; a file naming another mechanism
+  than the robot's is refused.
 
 Columns may come in any order; the separator is a comma; ``#`` starts a
 comment line; blank lines are ignored; a UTF-8 byte-order mark is accepted.
@@ -35,23 +43,23 @@ from __future__ import annotations
 
 import csv
 import io
+from dataclasses import dataclass
 
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (_check_header, _check_pose_numbers, _format_meta, _read_text,
-                                    _rows_to_records, _split_csv)
+from zerocal_sym.io.csvtext import (MECHANISM_KEY, _check_header, _check_pose_numbers, _format_meta, _go_together,
+                                    _read_text, _rows_to_records, _split_csv, get_mechanism_of, infer_mechanism,
+                                    joint_columns, mechanism_for_shape, pose_columns)
 from zerocal_sym.io.files import atomic_write_text
 from zerocal_sym.model.measurements import Measurements, _check_arrays
 
-REQUIRED_COLUMNS = ("pose", "theta1_deg", "theta2_deg", "reading_mm")
-OPTIONAL_COLUMNS = ("x_mm", "y_mm")
 FORMAT_LINE = "# zerocal measurements v1"
 FORMAT_VERSION = 1
 #: commanded poses farther than this outside the workspace are rejected (mm);
 #: compensation moves commanded angles by a few degrees, i.e. a few mm.
 WORKSPACE_TOL_MM = 25.0
-#: the commanded joint angles must reach within this of the target (x_mm, y_mm)
+#: the commanded joint angles must reach within this of the target (x_mm, y_mm, ...)
 #: (catches radians written as degrees and swapped columns; a compensation of
 #: a few degrees moves the platform by some 10 mm).
 TARGET_TOL_MM = 50.0
@@ -60,41 +68,158 @@ MIN_POSES = 5
 DUPLICATE_TOL_DEG = 1e-9
 
 
+@dataclass(frozen=True)
+class MeasurementColumns:
+    """The columns of a measurement file of one mechanism.
+
+    Attributes
+    ----------
+    mechanism : str
+    joints : tuple of str
+        ``theta1_deg, ...``, joint order.
+    pose : tuple of str
+        ``x_mm, y_mm[, z_mm]``, pose-coordinate order (the optional targets).
+    """
+
+    mechanism: str
+    joints: tuple
+    pose: tuple
+
+    @property
+    def required(self) -> tuple:
+        return ("pose",) + self.joints + ("reading_mm",)
+
+    @property
+    def optional(self) -> tuple:
+        return self.pose
+
+    @property
+    def allowed(self) -> tuple:
+        return self.required + self.optional
+
+    @property
+    def example(self) -> str:
+        """``pose,theta1_deg,theta2_deg,reading_mm[,x_mm,y_mm]``."""
+        return ",".join(self.required) + "[," + ",".join(self.pose) + "]"
+
+    def header(self, targets: bool) -> list:
+        return list(self.required) + (list(self.optional) if targets else [])
+
+
+def measurement_columns(mechanism=None) -> MeasurementColumns:
+    """The columns of the measurement file of ``mechanism`` (name, Mechanism or Robot; None: the default)."""
+    mech = get_mechanism_of(mechanism)
+    return MeasurementColumns(mech.name, joint_columns(mech), pose_columns(mech))
+
+
+def __getattr__(name):
+    # the default (planar) mechanism's columns, for code written before the mechanisms
+    if name == "REQUIRED_COLUMNS":
+        return measurement_columns().required
+    if name == "OPTIONAL_COLUMNS":
+        return measurement_columns().optional
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 # --------------------------------------------------------------------------- writing
 
-def format_measurements(meas: Measurements) -> str:
-    """CSV text of ``meas`` in the documented format (floats written exactly)."""
-    theta, readings, target = _check_arrays(meas.theta_cmd, meas.readings, meas.target)
+def resolve_mechanism(theta_cmd, target=None, meta=None, mechanism=None, declared=None):
+    """The mechanism a writer names: given, declared, or the only one with these shapes.
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, m)
+    target : ndarray, shape (K, n) or None
+    meta : dict, optional
+        Its ``mechanism`` entry, if any, counts as declared.
+    mechanism : str, Mechanism or Robot, optional
+    declared : str, optional
+        :attr:`Measurements.mechanism`.
+
+    Returns
+    -------
+    Mechanism
+
+    Raises
+    ------
+    ValueError
+        Conflicting names, an unknown one, shapes that do not fit it, or (none
+        named) not exactly one registered mechanism with these shapes.
+    """
+    theta_cmd, _, target = _check_arrays(theta_cmd, None, target)
+    named = [get_mechanism_of(x).name for x in (mechanism, declared, (meta or {}).get(MECHANISM_KEY))
+             if x is not None]
+    if len(set(named)) > 1:
+        raise ValueError(f"conflicting mechanisms: {', '.join(dict.fromkeys(named))}")
+    m, n = theta_cmd.shape[1], None if target is None else target.shape[1]
+    if named:
+        mech = get_mechanism_of(named[0])
+        _check_arrays(theta_cmd, None, target, mech.m, mech.n)
+        return mech
+    mech = mechanism_for_shape(m, n)
+    if mech is None:
+        raise ValueError(f"no single registered mechanism has {m} joints" +
+                         ("" if n is None else f" and {n} pose coordinates") + ": pass mechanism=")
+    return mech
+
+
+def _write(theta_cmd, readings, target, meta, mech, first_meta=None) -> str:
+    cols = measurement_columns(mech)
+    meta = dict(meta or {})
+    meta.pop(MECHANISM_KEY, None)
     buf = io.StringIO()
     buf.write(FORMAT_LINE + "\n")
-    buf.write(_format_meta(meas.meta))
-    cols = list(REQUIRED_COLUMNS) + (list(OPTIONAL_COLUMNS) if target is not None else [])
+    buf.write(_format_meta({MECHANISM_KEY: mech.name, **(first_meta or {}), **meta}))
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(cols)
-    deg = np.degrees(theta)
-    for k in range(theta.shape[0]):
-        row = [k, repr(float(deg[k, 0])), repr(float(deg[k, 1])), repr(float(readings[k]))]
+    w.writerow(cols.header(target is not None))
+    deg = np.degrees(theta_cmd)
+    for k in range(theta_cmd.shape[0]):
+        row = [k] + [repr(float(v)) for v in deg[k]]
+        row.append(("0" if k == 0 else "") if readings is None else repr(float(readings[k])))
         if target is not None:
-            row += [repr(float(target[k, 0])), repr(float(target[k, 1]))]
+            row += [repr(float(v)) for v in target[k]]
         w.writerow(row)
     return buf.getvalue()
 
 
-def write_measurements(path, meas: Measurements) -> None:
-    """Write ``meas`` to ``path`` atomically."""
-    atomic_write_text(path, format_measurements(meas))
+def format_measurements(meas: Measurements, mechanism=None) -> str:
+    """CSV text of ``meas`` in the documented format (floats written exactly).
+
+    Parameters
+    ----------
+    meas : Measurements
+    mechanism : str, Mechanism or Robot, optional
+        The mechanism to name in the ``# mechanism:`` line; default
+        ``meas.mechanism``, ``meas.meta["mechanism"]``, or the registered
+        mechanism with ``meas``'s shapes (see :func:`resolve_mechanism`).
+
+    Raises
+    ------
+    ValueError
+        Non-finite values, or shapes that fit no (or not the named) mechanism.
+    """
+    theta, readings, target = _check_arrays(meas.theta_cmd, meas.readings, meas.target)
+    mech = resolve_mechanism(theta, target, meas.meta, mechanism, meas.mechanism)
+    return _write(theta, readings, target, meas.meta, mech)
 
 
-def format_template(theta_cmd, target=None, meta=None) -> str:
+def write_measurements(path, meas: Measurements, mechanism=None) -> None:
+    """Write ``meas`` to ``path`` atomically (see :func:`format_measurements`)."""
+    atomic_write_text(path, format_measurements(meas, mechanism))
+
+
+def format_template(theta_cmd, target=None, meta=None, mechanism=None) -> str:
     """A measurement file to fill in: the poses to visit, ``reading_mm`` blank.
 
     Parameters
     ----------
-    theta_cmd : ndarray, shape (K, 2)
+    theta_cmd : ndarray, shape (K, m)
         Joint angles to command, rad.
-    target : ndarray, shape (K, 2), optional
+    target : ndarray, shape (K, n), optional
         Nominal target positions, mm.
     meta : dict, optional
+    mechanism : str, Mechanism or Robot, optional
+        Default: the registered mechanism with these shapes.
 
     Returns
     -------
@@ -103,20 +228,9 @@ def format_template(theta_cmd, target=None, meta=None) -> str:
         loader refuses the file until every reading is filled in).
     """
     theta_cmd, _, target = _check_arrays(theta_cmd, None, target)
-    buf = io.StringIO()
-    buf.write(FORMAT_LINE + "\n")
-    buf.write(_format_meta({"note": "fill in reading_mm: the scale reading at each pose (head reset after each)",
-                           **(meta or {})}))
-    cols = list(REQUIRED_COLUMNS) + (list(OPTIONAL_COLUMNS) if target is not None else [])
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(cols)
-    deg = np.degrees(theta_cmd)
-    for k in range(theta_cmd.shape[0]):
-        row = [k, repr(float(deg[k, 0])), repr(float(deg[k, 1])), "0" if k == 0 else ""]
-        if target is not None:
-            row += [repr(float(target[k, 0])), repr(float(target[k, 1]))]
-        w.writerow(row)
-    return buf.getvalue()
+    mech = resolve_mechanism(theta_cmd, target, meta, mechanism)
+    note = {"note": "fill in reading_mm: the scale reading at each pose (head reset after each)"}
+    return _write(theta_cmd, None, target, meta, mech, note)
 
 
 # --------------------------------------------------------------------------- reading
@@ -128,19 +242,22 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     ----------
     path : str or Path
     robot : Robot, optional
-        If given: every commanded pose must be reachable and (within
-        :data:`WORKSPACE_TOL_MM`) inside the robot's workspace; the targets
-        (if any) inside the workspace and within :data:`TARGET_TOL_MM` of
-        where the commanded angles lead; a ``robot_sha256`` metadata line
-        must match the robot.
+        If given: the file must be of the robot's mechanism (its
+        ``# mechanism:`` line, if any, and its columns); every commanded pose
+        must be reachable and (within :data:`WORKSPACE_TOL_MM`) inside the
+        robot's workspace; the targets (if any) inside the workspace and
+        within :data:`TARGET_TOL_MM` of where the commanded angles lead; a
+        ``robot_sha256`` metadata line must match the robot.  Without a
+        robot, the columns are those of the mechanism the file names, or of
+        the registered mechanism whose columns the header has.
     min_poses : int
         At least this many poses (5 for the paper's 4 parameters).
 
     Returns
     -------
     Measurements
-        ``theta_cmd`` shape (K, 2) rad, ``readings`` shape (K,) mm,
-        ``target`` shape (K, 2) mm or None.
+        ``theta_cmd`` shape (K, m) rad, ``readings`` shape (K,) mm,
+        ``target`` shape (K, n) mm or None; ``mechanism`` the mechanism read.
 
     Raises
     ------
@@ -149,14 +266,24 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     """
     text, src = _read_text(path)
     meta, meta_lines, rows = _split_csv(text, src, "# zerocal measurements", FORMAT_VERSION)
-    example = ",".join(REQUIRED_COLUMNS) + "[,x_mm,y_mm]"
+    declared = _declared_mechanism(meta, meta_lines, src, robot)
+    if robot is not None:
+        mech = robot.mechanism
+    elif declared is not None:
+        mech = get_mechanism_of(declared)
+    else:
+        mech = infer_mechanism(rows[0][1]) if rows else get_mechanism_of(None)
+    cols = measurement_columns(mech)
     if not rows:
-        raise DataFileError(f"empty file: no header line and no data (expected the header {example})", where=src)
+        raise DataFileError(f"empty file: no header line and no data (expected the header {cols.example})",
+                            where=src)
     header_line, header = rows[0]
-    _check_header(header, header_line, src, REQUIRED_COLUMNS + OPTIONAL_COLUMNS, REQUIRED_COLUMNS, example)
-    has_xy = [c in header for c in OPTIONAL_COLUMNS]
-    if any(has_xy) and not all(has_xy):
-        raise DataFileError("columns x_mm and y_mm go together (both or neither)", where=f"{src}:{header_line}")
+    if robot is not None and declared is None:
+        _check_columns_fit_robot(header, f"{src}:{header_line}", robot)
+    _check_header(header, header_line, src, cols.allowed, cols.required, cols.example)
+    has_pose = [c in header for c in cols.pose]
+    if any(has_pose) and not all(has_pose):
+        raise DataFileError(_go_together(cols.pose), where=f"{src}:{header_line}")
     data = rows[1:]
     if not data:
         raise DataFileError("no data rows after the header", where=f"{src}:{header_line}")
@@ -167,20 +294,49 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
         raise DataFileError(f"column 'reading_mm' (field {header.index('reading_mm') + 1}): the reading at pose 0 "
                             f"must be 0 (the head is reset there), got {values[0]['reading_mm']:g}",
                             where=f"{src}:{lines[0]}")
-    theta = np.radians(np.array([[r["theta1_deg"], r["theta2_deg"]] for r in values]))
+    theta = np.radians(np.array([[r[c] for c in cols.joints] for r in values]))
     readings = np.array([r["reading_mm"] for r in values])
-    target = np.array([[r["x_mm"], r["y_mm"]] for r in values]) if all(has_xy) else None
-    meas = Measurements(theta, readings, target, meta, src, lines, meta_lines)
+    target = np.array([[r[c] for c in cols.pose] for r in values]) if all(has_pose) else None
+    meas = Measurements(theta, readings, target, meta, src, lines, meta_lines, mech.name)
     if K < min_poses:
         raise DataFileError(f"too few poses: {K} (at least {min_poses} are needed to identify the parameters)",
                             where=src)
-    _check_duplicates(meas)
+    _check_duplicates(meas, cols)
     if robot is not None:
         check_against_robot(meas, robot)
     return meas
 
 
-def _check_duplicates(meas: Measurements) -> None:
+def _declared_mechanism(meta, meta_lines, src, robot):
+    """The file's ``# mechanism:`` (None without); unknown or not the robot's: DataFileError."""
+    from zerocal_sym.model.mechanism import REGISTRY
+
+    declared = meta.get(MECHANISM_KEY)
+    if declared is None:
+        return None
+    where = f"{src}:{meta_lines[MECHANISM_KEY]}"
+    if declared not in REGISTRY:
+        raise DataFileError(f"unknown mechanism {declared!r} (known: {', '.join(REGISTRY)})", where=where)
+    if robot is not None and declared != robot.mechanism_name:
+        raise DataFileError(f"measured with mechanism {declared}, the robot file is {robot.mechanism_name} "
+                            f"({robot.source}): pass the robot file of the measured robot", where=where)
+    return declared
+
+
+def _check_columns_fit_robot(header, where, robot) -> None:
+    """A file without ``# mechanism:`` whose columns are exactly another mechanism's: DataFileError."""
+    other = infer_mechanism(header)
+    if other.name == robot.mechanism_name:
+        return
+    cols = measurement_columns(other)
+    h = set(header)
+    if set(cols.required) <= h and h - set(cols.required) in (set(), set(cols.pose)):
+        raise DataFileError(f"the columns are those of mechanism {other.name} ({', '.join(cols.joints)}), "
+                            f"the robot file is {robot.mechanism_name} ({robot.source}): pass the robot file of "
+                            "the measured robot", where=where)
+
+
+def _check_duplicates(meas: Measurements, cols: MeasurementColumns) -> None:
     deg = np.degrees(meas.theta_cmd)
     for k in range(1, meas.K):
         d = np.max(np.abs(deg[:k] - deg[k]), axis=1)
@@ -192,19 +348,31 @@ def _check_duplicates(meas: Measurements) -> None:
             dt = np.max(np.abs(meas.target[:k] - meas.target[k]), axis=1)
             j = int(np.argmin(dt))
             if dt[j] <= 1e-9:
-                raise DataFileError(f"duplicated pose: pose {k} repeats the target (x_mm, y_mm) of pose {j} "
-                                    f"(line {meas.lines[j]})", where=meas.where(k))
+                raise DataFileError(f"duplicated pose: pose {k} repeats the target ({', '.join(cols.pose)}) of "
+                                    f"pose {j} (line {meas.lines[j]})", where=meas.where(k))
 
 
 def check_against_robot(meas: Measurements, robot) -> None:
-    """Every commanded pose reachable and inside the workspace (see :func:`load_measurements`).
+    """The mechanism and the robot fit, every commanded pose reachable and inside the workspace.
+
+    See :func:`load_measurements`.
 
     Raises
     ------
     DataFileError
     """
     from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.model.kinematics import fmt_pose
 
+    line = meas.meta_lines.get(MECHANISM_KEY)
+    if meas.mechanism is not None and meas.mechanism != robot.mechanism_name:
+        raise DataFileError(f"measured with mechanism {meas.mechanism}, the robot file is {robot.mechanism_name} "
+                            f"({robot.source}): pass the robot file of the measured robot",
+                            where=f"{meas.source}:{line}" if line else meas.source)
+    cols = measurement_columns(robot)
+    if meas.m != robot.m or meas.n not in (None, robot.n):
+        raise DataFileError(f"{meas.m} joint and {meas.n or 0} target columns, the robot's mechanism "
+                            f"{robot.mechanism_name} has {cols.example}", where=meas.source)
     sha = meas.meta.get("robot_sha256")
     if sha and sha != robot.sha256:
         line = meas.meta_lines.get("robot_sha256")
@@ -214,25 +382,24 @@ def check_against_robot(meas: Measurements, robot) -> None:
             where=f"{meas.source}:{line}" if line else meas.source)
     with np.errstate(all="ignore"):
         P = kin.fk(robot, meas.theta_cmd)
-    lo, hi = robot.workspace_bounds()
+    ws = robot.workspace
+    target_what = f"target ({', '.join(cols.pose)})"
     for k in range(meas.K):
         if not np.all(np.isfinite(P[k])):
-            t1, t2 = np.degrees(meas.theta_cmd[k])
-            raise DataFileError(f"commanded joint angles ({t1:g}, {t2:g}) deg are not an assembly of the robot "
-                                "(unreachable pose; angles in degrees?)", where=meas.where(k))
+            raise DataFileError(f"commanded joint angles {fmt_pose(np.degrees(meas.theta_cmd[k]))} deg are not an "
+                                "assembly of the robot (unreachable pose; angles in degrees?)", where=meas.where(k))
         pts = [("commanded", P[k], WORKSPACE_TOL_MM)]
         if meas.target is not None:
-            pts.append(("target (x_mm, y_mm)", meas.target[k], 1e-6))
+            pts.append((target_what, meas.target[k], 1e-6))
         for what, p, tol in pts:
-            if np.any(p < lo - tol) or np.any(p > hi + tol):
+            if not ws.contains(p, tol)[0]:
                 raise DataFileError(
-                    f"{what} pose ({p[0]:.3f}, {p[1]:.3f}) mm is outside the workspace "
-                    f"x in [{lo[0]:g}, {hi[0]:g}], y in [{lo[1]:g}, {hi[1]:g}] (tolerance {tol:g} mm)",
-                    where=meas.where(k))
+                    f"{what} pose {fmt_pose(p, '.3f')} mm is outside the workspace {ws.describe()} "
+                    f"(tolerance {tol:g} mm)", where=meas.where(k))
         if meas.target is not None:
             dist = float(np.linalg.norm(P[k] - meas.target[k]))
             if dist > TARGET_TOL_MM:
                 raise DataFileError(
-                    f"the commanded joint angles reach ({P[k, 0]:.3f}, {P[k, 1]:.3f}) mm, {dist:.1f} mm from the "
-                    f"target ({meas.target[k, 0]:g}, {meas.target[k, 1]:g}) mm (more than {TARGET_TOL_MM:g} mm: "
+                    f"the commanded joint angles reach {fmt_pose(P[k], '.3f')} mm, {dist:.1f} mm from the "
+                    f"target {fmt_pose(meas.target[k])} mm (more than {TARGET_TOL_MM:g} mm: "
                     "columns swapped, or angles not in degrees?)", where=meas.where(k))
