@@ -71,7 +71,9 @@ def test_identify_geometric_params_with_enough_poses(csv_file, capsys):
 def test_not_converged_exits_nonzero_without_file(csv_file, capsys, tmp_path):
     path, _ = csv_file(group=1)
     out = tmp_path / "res.json"
-    rc, d, err = run_json(capsys, ["identify", str(path), "--max-iter", "1", "--json", "--out", str(out)])
+    # the bound keeps Gauss-Newton's point out, so Ipopt has to travel: 1 iteration does not converge
+    rc, d, err = run_json(capsys, ["identify", str(path), "--max-iter", "1", "--bound", "rMx=-5:0.5", "--json",
+                                   "--out", str(out)])
     assert rc == 1 and not out.exists()
     assert "identification failed" in err and "did not converge" in err
     assert d["success"] is False

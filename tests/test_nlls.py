@@ -74,7 +74,10 @@ def test_all_twelve_is_flagged_not_identifiable(robot):
 
 
 def test_not_converged_is_not_a_calibration(robot, th6):
-    res = identify_nlls(robot, _meas(robot, th6, table2_errors(1)), "paper", warm_start=None, max_iter=1)
+    # the bound keeps Gauss-Newton's point out, so Ipopt must travel from the start: 1 iteration is not enough
+    res = identify_nlls(robot, _meas(robot, th6, table2_errors(1)), "paper", warm_start=None, max_iter=1,
+                        bounds={"rMx": (-5.0, 0.5)})
+    assert not res.info["gauss_newton"]["converged"]
     assert not res.success
     assert "did not converge" in res.status and "Maximum_Iterations" in res.info["solver_status"]
 
@@ -170,3 +173,30 @@ def test_monte_carlo_rms_within_10pct_of_crlb(robot, th6):
     ratio = rms / cr
     print(f"RMS/CRLB zero offsets: {ratio}")
     assert np.all(np.abs(ratio - 1) < 0.10)
+
+
+def test_batch_equals_the_single_path(robot, th6):
+    """identify_batch (Gauss-Newton mapped over data sets) gives the single path's answers and stds."""
+    from zerocal_sym.identify.batch import identify_batch
+
+    noise = NoiseModel.paper()
+    plant = VirtualPlant(robot, table2_errors(1))
+    R = np.array([plant.measure(th6, noise, k) for k in range(30)])
+    b = identify_batch(robot, th6, R, noise=noise)
+    assert b.confirmed.all() and b.success.all()
+    for k in range(0, 30, 7):
+        one = identify_nlls(robot, Measurements(th6, R[k]), noise=noise)
+        np.testing.assert_allclose(np.degrees(b.estimate[k]), np.degrees(one.estimate), atol=1e-9)
+        np.testing.assert_allclose(b.std[k], [one.std(n) for n in one.params], rtol=1e-8)
+        assert b.chi2[k] == pytest.approx(one.info["chi2"], rel=1e-8)
+
+
+def test_batch_hands_unconfirmed_sets_to_the_single_path(robot, th6):
+    """A data set Gauss-Newton cannot confirm (here: readings of a far-off robot) goes through Ipopt."""
+    from zerocal_sym.identify.batch import identify_batch
+
+    good = VirtualPlant(robot, table2_errors(1)).measure(th6)
+    wild = good * 50.0
+    b = identify_batch(robot, th6, np.array([good, wild]), noise=NoiseModel.paper())
+    assert b.confirmed[0] and b.success[0]
+    assert not b.confirmed[1]  # decided by identify_nlls, whatever its verdict

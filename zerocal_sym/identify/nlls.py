@@ -40,7 +40,6 @@ Priors and bounds
 """
 from __future__ import annotations
 
-import threading
 import time
 
 import numpy as np
@@ -48,108 +47,17 @@ import numpy as np
 from zerocal_sym.identify import fisher
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.model.noise import NoiseModel
+from zerocal_sym.identify.nlls_problem import get_problem
 from zerocal_sym.identify.result import IdentificationResult
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
 UNIT_SIGMA_MM = 1e-3
-#: Ipopt options (silenced)
-IPOPT_OPTIONS = {
-    "ipopt.print_level": 0,
-    "ipopt.sb": "yes",
-    "ipopt.tol": 1e-10,
-    "ipopt.acceptable_tol": 1e-7,
-    "ipopt.nlp_scaling_method": "none",
-    "ipopt.max_iter": 200,
-    "print_time": False,
-}
 #: Ipopt return statuses that count as converged (anything else: success False)
 CONVERGED_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 #: relative threshold on singular values of the scaled, whitened Jacobian
 RANK_RTOL = 1e-9
-
-_CACHE: dict = {}
-_LOCK = threading.Lock()
-
-
-class _Problem:
-    """One cached NLP for (mechanism, K, parameter indices)."""
-
-    def __init__(self, mechanism, K: int, idx: tuple):
-        import casadi as ca
-
-        self.K, self.idx, self.n = K, idx, len(idx)
-        m = K - 1
-        f = mechanism["distance"]
-        z = ca.SX.sym("z", self.n)
-        th = ca.SX.sym("theta", f.size1_in(0), K)
-        g = ca.SX.sym("g", f.size1_in(1))
-        efix = ca.SX.sym("err_fixed", f.size1_in(2))
-        s = ca.SX.sym("s", m)
-        W = ca.SX.sym("W", m, m)
-        sc = ca.SX.sym("scale", self.n)   # p = z / sc
-        mu = ca.SX.sym("prior_mean", self.n)
-        w = ca.SX.sym("prior_W", self.n, self.n)  # prior whitener (physical), 0 = no prior
-        c = ca.SX.sym("obj_scale")        # objective scaling (GN Hessian of norm ~1)
-        # the full error vector: fixed values, the estimated ones replacing theirs
-        E = np.zeros((f.size1_in(2), self.n))
-        E[list(idx), range(self.n)] = 1.0
-        keep = np.ones(f.size1_in(2))
-        keep[list(idx)] = 0.0
-        p = z / sc
-        err = ca.DM(keep) * efix + ca.mtimes(ca.DM(E), p)
-        rho = f.map(K)(th, g, err)            # 1 x K
-        pred = (rho[0, 1:] - rho[0, :-1]).T   # m x 1
-        r = ca.mtimes(W, s - pred)
-        rp = ca.mtimes(w, p - mu)
-        res = ca.vertcat(r, rp)
-        J = ca.jacobian(res, z)
-        par = ca.vertcat(ca.vec(th), g, efix, s, ca.vec(W), sc, mu, ca.vec(w), c)
-        self.npar = par.numel()
-        cost = 0.5 * c * ca.dot(res, res)
-        nlp = {"x": z, "p": par, "f": cost}
-        sigma = ca.SX.sym("lam_f")
-        lam_g = ca.SX.sym("lam_g", 0)
-        H = ca.triu(sigma * c * ca.mtimes(J.T, J))
-        hess = ca.Function("nlp_hess_l", [z, par, sigma, lam_g], [H],
-                           ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])
-        self._nlp, self._hess, self._solvers = nlp, hess, {}
-        self.solver = self.solver_for(None)
-        self.resfun = ca.Function("residuals", [z, par], [r, rp, J, pred],
-                                  ["z", "p"], ["r", "r_prior", "J", "pred"])
-        self.rfun = ca.Function("r", [z, par], [r])
-        self.jfun = ca.Function("J", [z, par], [ca.jacobian(r, z)])
-
-    def solver_for(self, max_iter):
-        """The Ipopt solver with this iteration limit (None: the default), built once."""
-        import casadi as ca
-
-        if max_iter not in self._solvers:
-            opts = dict(IPOPT_OPTIONS, hess_lag=self._hess)
-            if max_iter is not None:
-                opts["ipopt.max_iter"] = int(max_iter)
-            self._solvers[max_iter] = ca.nlpsol("nlls", "ipopt", self._nlp, opts)
-        return self._solvers[max_iter]
-
-    def pack(self, theta_cmd, geometry, err_fixed, s, W, scale, mu, w, obj_scale=1.0):
-        """The NLP parameter vector.
-
-        ``theta_cmd`` shape (K, m), ``W`` shape (K-1, K-1), ``w`` (prior
-        whitener) shape (p, p).
-        """
-        return np.concatenate([np.asarray(theta_cmd, float).ravel(), geometry, err_fixed, s,
-                               np.asarray(W, float).ravel(order="F"), scale, mu,
-                               np.asarray(w, float).ravel(order="F"), [obj_scale]])
-
-
-def get_problem(robot, K: int, params="paper") -> _Problem:
-    """The cached NLP for ``K`` poses and the parameter set (built on first use)."""
-    idx = tuple(robot.errors.indices(params))
-    key = (robot.mechanism_name, K, idx)
-    with _LOCK:
-        prob = _CACHE.get(key)
-        if prob is None:
-            prob = _CACHE[key] = _Problem(robot.mechanism, K, idx)
-    return prob
+#: Gauss-Newton is converged when its last step is below this (scaled units, mm)
+GN_STEP_TOL = 1e-8
 
 
 def _as_vector(x, n, what):
@@ -159,10 +67,11 @@ def _as_vector(x, n, what):
     return a
 
 
-def _weights(robot, theta_cmd, noise, err):
+def noise_terms(noise: NoiseModel):
+    """``(sigma_m^2, sigma_xi^2)`` of the whitening; a zero model weights every change by 1 um."""
     if noise.is_zero:
-        return np.eye(theta_cmd.shape[0] - 1) / UNIT_SIGMA_MM
-    return fisher.whitener(fisher.measurement_covariance(robot, theta_cmd, noise, err))
+        return UNIT_SIGMA_MM**2, 0.0
+    return float(noise.sigma_scale_mm) ** 2, float(noise.sigma_servo_rad) ** 2
 
 
 def _bounds(bounds, names, scale):
@@ -209,7 +118,7 @@ def _initial(robot, meas, names, prior_q, warm_start):
 
 
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
-                  bounds=None, prior_std=None, warm_start="tsvd", reweight: int = 1,
+                  bounds=None, prior_std=None, warm_start=None, reweight: int = 1,
                   max_iter: int | None = None, prior_cov=None) -> IdentificationResult:
     """Maximum-likelihood (or MAP) identification with Ipopt on the exact model.
 
@@ -237,14 +146,22 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         Gaussian prior std (rad / mm); ``inf`` for none.
     prior_cov : ndarray, shape (p, p), optional
         Full Gaussian prior covariance instead of ``prior_std``.
-    warm_start : "tsvd", None or ndarray, shape (p,)
-        ``"tsvd"``: start from the truncated-SVD estimate (if
-        :mod:`zerocal_sym.identify.tsvd` is available, else from ``prior``).
+    warm_start : None, "tsvd" or ndarray, shape (p,)
+        Where Gauss-Newton starts: the prior (None, the default), the
+        truncated-SVD estimate, or given values.
     reweight : int
-        Re-evaluate the weights at the solution and solve again this many
-        times (the covariance of the changes depends weakly on the estimate).
+        1 (default): the weights (the covariance of the changes depends
+        weakly on the estimate) are re-evaluated at every Gauss-Newton iterate,
+        so the answer is their fixed point; 0: held at the start point.
     max_iter : int, optional
         Ipopt iteration limit (default 200).
+
+    Solution: ``N_GN`` damped Gauss-Newton iterations inside one CasADi
+    call (:mod:`zerocal_sym.identify.nlls_problem`), then one Ipopt solve from
+    that point, whose status decides ``success`` (Ipopt is the judge; from a
+    converged Gauss-Newton point it takes 0-1 iterations).  If Gauss-Newton
+    did not converge (or left the bounds) Ipopt starts at the start point
+    and, with ``reweight``, solves once more with the weights at its solution.
 
     Returns
     -------
@@ -298,39 +215,42 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
 
     prob = get_problem(robot, K, names)
     solver = prob.solver_for(max_iter)
-
-    def full(p):
-        return errors.put(prior_q, names, p)
-
+    par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
+    fast = prob.fast
+    z_gn, step, r, rp, J, pred, l, b = (np.array(o) for o in
+                                        fast["gauss_newton" if reweight else "gauss_newton_fixed"](z0, par))
+    step = float(step[0])
+    gn_ok = bool(np.all(np.isfinite(z_gn)) and step < GN_STEP_TOL and np.all(z_gn >= lbx) and np.all(z_gn <= ubx))
+    if gn_ok:  # Ipopt confirms the Gauss-Newton point (weights at that point)
+        z, passes = z_gn, 1
+    else:      # Ipopt from the start; with reweight once more with the weights at its solution
+        z, passes = z0, 1 + bool(reweight)
+        l, b = (np.array(o) for o in fast["weights"](z0, par))
     total_iter, stats = 0, {}
-    z = z0
-    for rnd in range(1 + max(0, int(reweight))):
-        W = _weights(robot, theta_cmd, noise, full(z / scale))
-        par = prob.pack(theta_cmd, robot.geometry, prior_q, s, W, scale, mu, w)
-        J0 = prob.resfun(z, par)[2].full()
-        par[-1] = 1.0 / max(1e-300, np.linalg.norm(J0, 2) ** 2)
-        sol = solver(x0=z, p=par, lbx=lbx, ubx=ubx)
+    for k in range(passes):
+        if k:
+            l, b = (np.array(o) for o in fast["weights"](z, par))
+        Jz = J[: K - 1] if (gn_ok and not k) else fast["jfun"](z, par, l, b)[0]
+        c = 1.0 / max(1e-300, float(np.sum(Jz * Jz)))  # GN Hessian of norm ~1 (Frobenius: no SVD)
+        zn = solver(z, np.concatenate([par, l, b, [c]]), lbx, ubx)[0].copy()
         stats = solver.stats()
         total_iter += int(stats.get("iter_count", 0))
-        zn = sol["x"].full().ravel()
-        if str(stats.get("return_status")) not in CONVERGED_STATUSES:
-            z = zn
-            break
-        moved = np.max(np.abs(zn - z)) if rnd else np.inf
+        moved = not np.array_equal(zn, z)
         z = zn
-        if rnd and moved < 1e-9:
+        if str(stats.get("return_status")) not in CONVERGED_STATUSES:
             break
     ret = str(stats.get("return_status", "unknown"))
     converged = ret in CONVERGED_STATUSES and bool(np.all(np.isfinite(z)))
     p_hat = z / scale
-    W = _weights(robot, theta_cmd, noise, full(p_hat))
-    par = prob.pack(theta_cmd, robot.geometry, prior_q, s, W, scale, mu, w)
-    r, rp, J, pred = (o.full() for o in prob.resfun(z, par))
-    r, rp = r.ravel(), rp.ravel()
+    if not gn_ok or moved:  # residuals and Jacobian at the final point (else Gauss-Newton's are current)
+        l, b = (np.array(o) for o in fast["weights"](z if reweight else z0, par))
+        r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
+    r, rp, pred = r.ravel(), rp.ravel(), pred.ravel()
     Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
-    F = J.T @ J      # data + prior information, scaled units
-    sv = np.linalg.svd(Jd, compute_uv=False) if Jd.size else np.zeros(0)
-    U, sF, Vt = np.linalg.svd(F)
+    # F = J^T J (data + prior information, scaled units) from one SVD of J: F = V diag(sJ^2) V^T
+    _, sJ, Vt = np.linalg.svd(J, full_matrices=False)
+    sF = sJ**2
+    sv = (np.linalg.svd(Jd, compute_uv=False) if np.any(w) else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
     tol = RANK_RTOL * (sF[0] if sF.size else 0.0)
     rank = int(np.sum(sF > tol))
     null = Vt[rank:]
@@ -372,9 +292,10 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "dof": (K - 1) - len(names),
         "time_s": time.perf_counter() - t0,
         "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
-                      "errors-in-variables: whitened by chol(Cov(s)), servo error propagated"),
+                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"),
         "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
         "warm_start": start,
+        "gauss_newton": {"converged": gn_ok, "last_step_mm": step},
         "initial": x0.tolist(),
         "rank": rank,
         "singular_values": sv.tolist(),
@@ -384,7 +305,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     }
     return IdentificationResult(method="nlls", params=names, estimate=p_hat,
                                 covariance=cov, success=bool(success), status=status,
-                                residuals=np.asarray(s - pred.ravel()), info=info, errors=errors)
+                                residuals=np.asarray(s - pred), info=info, errors=errors)
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):
@@ -447,9 +368,9 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
     prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
     scale = fisher.parameter_scale(robot, names)
-    W = _weights(robot, theta_cmd, noise, prior_q)
     prob = get_problem(robot, theta_cmd.shape[0], names)
-    par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], W, scale,
-                    errors.take(prior_q, names), np.zeros((len(names), len(names))))
+    par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], scale,
+                    errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
+    l, b = (o.full().ravel() for o in prob.weights(errors.take(prior_q, names) * scale, par))
     rfun, jfun = prob.rfun, prob.jfun
-    return (lambda z: rfun(z, par).full().ravel()), (lambda z: jfun(z, par).full()), scale
+    return (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full()), scale

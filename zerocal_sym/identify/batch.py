@@ -1,0 +1,137 @@
+"""Batched identification: N data sets of one design in one CasADi call.
+
+For Monte Carlo studies and design verification: the K commanded poses are
+the same for every data set, only the readings differ.  The Gauss-Newton
+iterations of :mod:`zerocal_sym.identify.nlls_problem` are mapped over the N
+data sets (``Function.map``) and evaluated in one zero-copy call; each data
+set is *confirmed* when its last Gauss-Newton step is below
+:data:`~zerocal_sym.identify.nlls.GN_STEP_TOL` (the same criterion as the
+single path uses before Ipopt confirms).  A data set that is not confirmed
+goes through :func:`zerocal_sym.identify.nlls.identify_nlls` (Ipopt the judge).
+The estimates of confirmed data sets equal the single path's to the
+Gauss-Newton tolerance (a test).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from zerocal_sym.identify import fisher
+from zerocal_sym.identify.nlls import GN_STEP_TOL, identify_nlls, noise_terms
+from zerocal_sym.identify.nlls_problem import FastCall, get_problem
+from zerocal_sym.model.measurements import Measurements
+from zerocal_sym.model.noise import NoiseModel
+
+#: data sets per mapped call (memory and the size of the mapped Function stay bounded)
+CHUNK = 1000
+
+
+@dataclass
+class BatchResult:
+    """N identifications of one design.
+
+    Attributes
+    ----------
+    params : tuple of str
+    estimate : ndarray, shape (N, p)
+        rad / mm; NaN where the identification failed.
+    std : ndarray, shape (N, p)
+        Standard deviations from the Fisher information at each estimate.
+    success : ndarray of bool, shape (N,)
+    confirmed : ndarray of bool, shape (N,)
+        Confirmed in the batch (False: handed to the single path).
+    chi2 : ndarray, shape (N,)
+        Sum of squared whitened residuals.
+    """
+
+    params: tuple
+    estimate: np.ndarray
+    std: np.ndarray
+    success: np.ndarray
+    confirmed: np.ndarray
+    chi2: np.ndarray
+
+    def values(self, names) -> np.ndarray:
+        """Columns of the estimate by name, shape (N, len(names))."""
+        return self.estimate[:, [self.params.index(n) for n in names]]
+
+
+_FAST: dict = {}
+
+
+def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel | None = None,
+                   prior=None) -> BatchResult:
+    """Identify N data sets measured at the same commanded joints.
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, m)
+    readings : ndarray, shape (N, K)
+        ``readings[:, 0] = 0``.
+    params, noise, prior
+        As :func:`zerocal_sym.identify.nlls.identify_nlls` (no bounds, no Gaussian prior).
+
+    Returns
+    -------
+    BatchResult
+    """
+    noise = NoiseModel.paper() if noise is None else noise
+    errors = robot.errors
+    names = errors.resolve(params)
+    theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
+    readings = np.atleast_2d(np.asarray(readings, float))
+    N, K = readings.shape
+    if theta_cmd.shape != (K, robot.m):
+        raise ValueError(f"theta_cmd must have shape ({K}, {robot.m}), got {theta_cmd.shape}")
+    prior_q = errors.zeros() if prior is None else errors.check_vector(prior, "prior")
+    p = len(names)
+    scale = fisher.parameter_scale(robot, names)
+    prob = get_problem(robot, K, names)
+    mu = errors.take(prior_q, names)
+    par = prob.pack(theta_cmd, robot.geometry, prior_q, np.zeros(K - 1), scale, mu, np.zeros((p, p)),
+                    *noise_terms(noise))
+    srows = prob.s_slice(len(robot.geometry), len(errors))
+    z0 = mu * scale
+    est = np.full((N, p), np.nan)
+    std = np.full((N, p), np.nan)
+    chi2 = np.full(N, np.nan)
+    confirmed = np.zeros(N, bool)
+    for a in range(0, N, CHUNK):
+        n = min(CHUNK, N - a)
+        key = (id(prob), n)
+        if key not in _FAST:
+            _FAST[key] = FastCall(prob.batch(n))
+        P = np.repeat(par[:, None], n, axis=1)
+        P[srows] = readings[a:a + n, 1:].T
+        z, step, r, _, J, *_ = _FAST[key](np.repeat(z0[:, None], n, axis=1), P)
+        z = z.reshape(p, n, order="F").T
+        J = J.reshape(K - 1 + p, p, n, order="F").transpose(2, 0, 1)[:, : K - 1]  # [J_1 | J_2 | ...]
+        r = r.reshape(K - 1, n, order="F").T
+        step = np.ravel(step)
+        ok = np.isfinite(step) & (step < GN_STEP_TOL) & np.all(np.isfinite(z), axis=1)
+        F = np.einsum("nki,nkj->nij", J, J)
+        try:
+            cov = np.linalg.inv(F[ok])
+        except np.linalg.LinAlgError:  # a singular design: leave every data set to the single path
+            ok[:] = False
+            cov = np.zeros((0, p, p))
+        s2 = 1.0
+        if noise.is_zero:  # unit weights: the covariance from the residuals
+            dof = K - 1 - p
+            s2 = (np.sum(r[ok] ** 2, axis=1) * noise_terms(noise)[0] / dof)[:, None] if dof > 0 else np.nan
+        sl = np.arange(a, a + n)[ok]
+        est[sl] = z[ok] / scale
+        std[sl] = np.sqrt(np.abs(np.diagonal(cov, axis1=1, axis2=2)) * s2) / scale
+        chi2[sl] = np.sum(r[ok] ** 2, axis=1)
+        confirmed[sl] = True
+    success = confirmed.copy()
+    for k in np.flatnonzero(~confirmed):  # the single path decides
+        res = identify_nlls(robot, Measurements(theta_cmd=theta_cmd, readings=readings[k]), names, noise=noise,
+                            prior=prior_q)
+        if res.success:
+            est[k] = res.estimate
+            std[k] = [res.std(nm) for nm in names]
+            chi2[k] = res.info["chi2"]
+            success[k] = True
+    return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed, chi2=chi2)

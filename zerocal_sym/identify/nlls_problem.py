@@ -1,0 +1,246 @@
+"""The CasADi functions of the nonlinear identification, built once per (mechanism, K, parameters).
+
+One model Function (the exact distance and its joint derivative at one pose)
+is vectorised over the K poses with ``map``; everything else is composed from
+it symbolically:
+
+``weights``
+    the banded whitening of the change covariance
+    ``C = sigma_m^2 I + D diag(v) D^T`` (``v_k = sigma_xi^2 |d rho_k / d theta|^2``):
+    ``C`` is tridiagonal, its Cholesky factor lower bidiagonal with diagonal
+    ``l`` (K-1) and sub-diagonal ``b`` (K-2); whitening is a forward
+    substitution.  Memory and time are linear in K; no dense K x K matrix.
+``residuals``
+    the whitened residuals of the changes and of the Gaussian prior, and their
+    Jacobian with respect to the scaled parameters, for given ``(l, b)``.
+``gauss_newton``
+    ``N_GN`` damped Gauss-Newton iterations inside one Function (weights
+    re-evaluated at each iterate, or held at the start), returning the
+    iterate, its residuals and Jacobian and the size of the last step;
+    ``gauss_newton_batch`` is the same mapped over data sets of one design.
+``solver``
+    Ipopt on ``0.5 c |r(z; l, b)|^2`` with the Gauss-Newton Hessian
+    (``hess_lag``), the weights as NLP parameters: the judge of convergence,
+    started at the Gauss-Newton point.
+
+Parameter vector (``pack``): ``theta (m x K), g, err_fixed, s (K-1), scale,
+prior mean, prior whitener (p x p), sigma_m^2, sigma_xi^2``.
+"""
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+#: Gauss-Newton iterations inside one call
+N_GN = 12
+#: Ipopt options (silenced)
+IPOPT_OPTIONS = {
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-10,
+    "ipopt.acceptable_tol": 1e-7,
+    "ipopt.nlp_scaling_method": "none",
+    "ipopt.max_iter": 200,
+    "print_time": False,
+}
+
+_CACHE: dict = {}
+_LOCK = threading.Lock()
+
+
+class FastCall:
+    """Zero-copy evaluation of a CasADi Function through its buffer (no numpy <-> DM conversion).
+
+    ``fc(*args)`` copies the arguments into preallocated arrays, runs the
+    Function in place and returns views of its preallocated outputs (dense,
+    column-major; matrices come back as ``(rows, cols)`` arrays).  The
+    outputs are overwritten by the next call: copy what you keep.  One
+    buffer per thread.
+    """
+
+    def __init__(self, f):
+        self.f = f
+        self._local = threading.local()
+        self.out_shapes = [f.size_out(i) for i in range(f.n_out())]
+
+    def _state(self):
+        st = getattr(self._local, "st", None)
+        if st is None:
+            f = self.f
+            buf, trigger = f.buffer()
+            ins = [np.zeros(f.nnz_in(i)) for i in range(f.n_in())]
+            outs = [np.zeros(f.nnz_out(i)) for i in range(f.n_out())]
+            for i, a in enumerate(ins):
+                buf.set_arg(i, memoryview(a))
+            for i, a in enumerate(outs):
+                buf.set_res(i, memoryview(a))
+            st = self._local.st = (buf, trigger, ins, outs)
+        return st
+
+    def __call__(self, *args):
+        buf, trigger, ins, outs = self._state()
+        for a, v in zip(ins, args):
+            a[:] = np.ravel(v, order="F")
+        trigger()
+        return [o.reshape(s, order="F") if s[1] > 1 else o for o, s in zip(outs, self.out_shapes)]
+
+    def stats(self) -> dict:
+        return self._state()[0].stats()
+
+
+def _banded_whiten(r, l, b):
+    """``L^-1 r`` for the lower-bidiagonal ``L`` (diagonal ``l``, sub-diagonal ``b``): forward substitution."""
+    import casadi as ca
+
+    out = [r[0] / l[0]]
+    for k in range(1, r.shape[0]):
+        out.append((r[k] - b[k - 1] * out[-1]) / l[k])
+    return ca.vertcat(*out)
+
+
+def _banded_cholesky(v, sm2):
+    """Diagonal and sub-diagonal of chol(sm2 I + D diag(v) D^T), D the (K-1) x K first differences."""
+    import casadi as ca
+
+    n = v.shape[0] - 1
+    c = [sm2 + v[k] + v[k + 1] for k in range(n)]
+    l, b = [ca.sqrt(c[0])], []
+    for k in range(1, n):
+        b.append(-v[k] / l[k - 1])
+        l.append(ca.sqrt(c[k] - b[-1] ** 2))
+    return ca.vertcat(*l), (ca.vertcat(*b) if b else ca.SX(0, 1))
+
+
+class NllsProblem:
+    """The cached functions for (mechanism, K, parameter indices)."""
+
+    def __init__(self, mechanism, K: int, idx: tuple):
+        import casadi as ca
+
+        f = mechanism["distance"]
+        m, G, q = f.size1_in(0), f.size1_in(1), f.size1_in(2)
+        self.K, self.idx, self.p, self.m = K, idx, len(idx), m
+        p = self.p
+        th1, g1, e1 = ca.SX.sym("th", m), ca.SX.sym("g", G), ca.SX.sym("e", q)
+        rho1 = f(th1, g1, e1)
+        pose = ca.Function("pose", [th1, g1, e1], [rho1, ca.sumsqr(ca.jacobian(rho1, th1))])
+        pose_k = pose.map(K)
+
+        z = ca.SX.sym("z", p)
+        th = ca.SX.sym("theta", m, K)
+        g = ca.SX.sym("g", G)
+        efix = ca.SX.sym("err_fixed", q)
+        s = ca.SX.sym("s", K - 1)
+        sc = ca.SX.sym("scale", p)          # p = z / sc
+        mu = ca.SX.sym("prior_mean", p)
+        w = ca.SX.sym("prior_W", p, p)      # prior whitener (physical units), 0 = no prior
+        sm2 = ca.SX.sym("sigma_m2")
+        sx2 = ca.SX.sym("sigma_xi2")
+        par = ca.vertcat(ca.vec(th), g, efix, s, sc, mu, ca.vec(w), sm2, sx2)
+        self.npar = par.numel()
+        E = np.zeros((q, p))
+        E[list(idx), range(p)] = 1.0
+        keep = np.ones(q)
+        keep[list(idx)] = 0.0
+        pz = z / sc
+        err = ca.DM(keep) * efix + ca.mtimes(ca.DM(E), pz)
+        rho, dth2 = pose_k(th, g, err)
+        pred = (rho[0, 1:] - rho[0, :-1]).T
+        l, b = _banded_cholesky(sx2 * dth2.T, sm2)
+        self.weights = ca.Function("weights", [z, par], [l, b], ["z", "p"], ["l", "b"])
+
+        L = ca.SX.sym("l", K - 1)
+        B = ca.SX.sym("b", max(K - 2, 0))
+        r = _banded_whiten(s - pred, L, B)
+        rp = ca.mtimes(w, pz - mu)
+        res = ca.vertcat(r, rp)
+        J = ca.jacobian(res, z)
+        self.residuals = ca.Function("residuals", [z, par, L, B], [r, rp, J, pred],
+                                     ["z", "p", "l", "b"], ["r", "r_prior", "J", "pred"])
+        self.rfun = ca.Function("r", [z, par, L, B], [r])
+        self.jfun = ca.Function("J", [z, par, L, B], [ca.jacobian(r, z)])
+
+        # one damped Gauss-Newton step; weights at z (reweight) or given
+        JtJ = ca.mtimes(J.T, J)
+        ridge = 1e-12 * (ca.mmax(ca.diag(JtJ)) + 1e-300)
+        dz = -ca.solve(JtJ + ridge * ca.SX.eye(p), ca.mtimes(J.T, res))
+        step_fixed = ca.Function("gn_step_fixed", [z, par, L, B], [z + dz, ca.norm_inf(dz)])
+        lz, bz = self.weights(z, par)
+        zn, dn = step_fixed(z, par, lz, bz)
+        step_rew = ca.Function("gn_step", [z, par], [zn, dn])
+
+        def unroll(reweight):
+            z0, pp = ca.MX.sym("z0", p), ca.MX.sym("p", self.npar)
+            lx, bx = self.weights(z0, pp)
+            zk, dk = z0, ca.MX(np.inf)
+            for _ in range(N_GN):
+                zk, dk = step_rew(zk, pp) if reweight else step_fixed(zk, pp, lx, bx)
+            lk, bk = self.weights(zk, pp) if reweight else (lx, bx)
+            rk, rpk, Jk, predk = self.residuals(zk, pp, lk, bk)
+            return ca.Function("gauss_newton", [z0, pp], [zk, dk, rk, rpk, Jk, predk, lk, bk],
+                               ["z0", "p"], ["z", "last_step", "r", "r_prior", "J", "pred", "l", "b"]).expand()
+
+        self.gauss_newton = unroll(True)
+        self.gauss_newton_fixed = unroll(False)
+
+        c = ca.SX.sym("obj_scale")
+        nlp = {"x": z, "p": ca.vertcat(par, L, B, c), "f": 0.5 * c * ca.dot(res, res)}
+        sigma = ca.SX.sym("lam_f")
+        H = ca.triu(sigma * c * JtJ)
+        self._hess = ca.Function("nlp_hess_l", [z, nlp["p"], sigma, ca.SX.sym("lam_g", 0)], [H],
+                                 ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])
+        self._nlp, self._solvers = nlp, {}
+        self._batch = {}
+        # zero-copy callers of the functions identify_nlls calls every time
+        self.fast = {name: FastCall(getattr(self, name))
+                     for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun")}
+
+    def solver_for(self, max_iter):
+        """The Ipopt solver with this iteration limit (None: the default), built once.
+
+        Returns a :class:`FastCall`: ``solver(x0, p, lbx, ubx)`` -> ``[x, f, ...]``;
+        ``solver.stats()`` the Ipopt statistics of the last call.
+        """
+        import casadi as ca
+
+        if max_iter not in self._solvers:
+            opts = dict(IPOPT_OPTIONS, hess_lag=self._hess)
+            if max_iter is not None:
+                opts["ipopt.max_iter"] = int(max_iter)
+            self._solvers[max_iter] = FastCall(ca.nlpsol("nlls", "ipopt", self._nlp, opts))
+        return self._solvers[max_iter]
+
+    @property
+    def solver(self):
+        return self.solver_for(None)
+
+    def batch(self, N: int):
+        """``gauss_newton`` mapped over N data sets (columns of z0 and of the parameter vector)."""
+        if N not in self._batch:
+            self._batch[N] = self.gauss_newton.map(N)
+        return self._batch[N]
+
+    def pack(self, theta_cmd, geometry, err_fixed, s, scale, mu, w, sm2, sx2):
+        """The parameter vector, shape (npar,).
+
+        ``theta_cmd`` shape (K, m), ``s`` (K-1,), ``w`` (prior whitener) shape (p, p).
+        """
+        return np.concatenate([np.asarray(theta_cmd, float).ravel(), geometry, err_fixed, s, scale, mu,
+                               np.asarray(w, float).ravel(order="F"), [sm2, sx2]])
+
+    def s_slice(self, G: int, q: int) -> slice:
+        """Where the K-1 changes sit in the parameter vector."""
+        start = self.m * self.K + G + q
+        return slice(start, start + self.K - 1)
+
+
+def get_problem(robot, K: int, params="paper") -> NllsProblem:
+    """The cached problem for ``K`` poses and the parameter set (built on first use)."""
+    idx = tuple(robot.errors.indices(params))
+    key = (robot.mechanism_name, K, idx)
+    with _LOCK:
+        prob = _CACHE.get(key)
+        if prob is None:
+            prob = _CACHE[key] = NllsProblem(robot.mechanism, K, idx)
+    return prob
