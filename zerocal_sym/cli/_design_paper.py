@@ -12,11 +12,10 @@ paper's frame, which is ours mirrored about the x axis (docs/reproduction.md).
 from __future__ import annotations
 
 
-def run(args):
+def run(args, robot):
     import numpy as np
 
     from zerocal_sym.model import kinematics as kin
-    from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import PoseError, ZerocalError
     from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
     from zerocal_sym.io.files import to_json
@@ -26,10 +25,13 @@ def run(args):
     from zerocal_sym.paper.scheme import paper_poses
     from zerocal_sym.identify.linear import identification_matrix
 
-    robot = load_robot_arg(args)
-    prior = tuple(float(v) for v in args.maemm_prior) if args.maemm_prior else DEFAULT_MAEMM_PRIOR
-    if not all(np.isfinite(prior)):
-        raise ZerocalError("--maemm-prior must be finite numbers (mm)")
+    from zerocal_sym.cli._common import vector_arg
+
+    errors = robot.errors
+    prior = (tuple(vector_arg(args.maemm_prior, len(errors.measuring), "--maemm-prior", errors.measuring, "mm"))
+             if args.maemm_prior else DEFAULT_MAEMM_PRIOR)
+    if args.eps0 is None:
+        args.eps0 = 0.01
     if args.n is not None and args.n < 3:
         raise PoseError(f"--n {args.n} gives K = {2 * args.n} < 5 poses: the 4 parameters are not identifiable "
                         "(n >= 3 needed)")

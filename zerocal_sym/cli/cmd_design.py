@@ -1,29 +1,48 @@
 """Measurement-pose design.
 
-``--scheme paper`` (default): the paper's Section 5 scheme, n evenly spaced
-poses on each of the boundaries y = H and y = H + h (order: along y = H from
-x = -b/2 to +b/2, then along y = H + h again from -b/2 to +b/2); without
-``--n`` the smallest n with eps = (kappa_1 - kappa_m)/kappa_1 <= eps0.
+``--scheme`` (default: the robot's own) -- the boundary scheme of the robot's
+workspace, n poses on each of its two boundaries, K = 2n:
 
-``--optimize``: K poses chosen by a constrained optimisation (CasADi/Ipopt)
-for a criterion, compared with the paper's scheme at the same K.
+* ``paper`` (a rectangular workspace, the paper's Section 5): n evenly
+  spaced poses on y = H and on y = H + h (each from x = -b/2 to +b/2);
+  prints kappa_1, kappa_m (with the MAEMM prior, Eq. 30), the eps rule
+  (Eq. 31; without ``--n`` the smallest n with eps <= eps0) and the CRLB of
+  the zero offsets;
+* ``ring`` (a cylindrical workspace, the rotary Delta of DELTA.md): n poses
+  on the top circle at azimuths 360 deg j/n, then on the bottom one; prints
+  kappa_1 (the condition number of the paper's G, Eq. 28 in 3-D, no MAEMM
+  prior), the CRLB of the zero offsets (paper noise and scale error alone)
+  and, without ``--n``, the default n = 6 with kappa_1 and the CRLB for the
+  other n.
+
+A scheme that does not fit the robot's workspace is an error naming the
+right one.
+
+``--optimize``: K poses chosen by a constrained optimisation (CasADi/Ipopt
+and a discrete exchange) for a criterion, over the robot's workspace shape
+(a rectangle or a cylinder), compared with the boundary scheme at the same K.
 """
 NAME = "design"
-HELP = "measurement poses: the paper's scheme or an optimised design"
+HELP = "measurement poses: the robot's boundary scheme (paper, ring) or an optimised design"
 
 
 def add_arguments(p):
-    p.add_argument("--scheme", choices=["paper"], default="paper", help="pose scheme (default: paper)")
-    p.add_argument("--n", type=int, default=None, help="poses per boundary (paper scheme); default: eps0 rule")
-    p.add_argument("--eps0", type=float, default=0.01, help="threshold of the eps rule (default 0.01)")
-    p.add_argument("--maemm-prior", nargs=2, type=float, metavar=("X", "Y"), default=None,
-                   help="MAEMM prior (mm) for kappa_m (default: see docs/reproduction.md)")
-    p.add_argument("--optimize", action="store_true", help="optimise the poses instead of the paper's scheme")
-    p.add_argument("--K", type=int, default=6, help="number of poses (--optimize)")
+    p.add_argument("--scheme", choices=["paper", "ring"], default=None,
+                   help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
+    p.add_argument("--n", type=int, default=None,
+                   help="poses per boundary; default: the eps0 rule (paper), 6 (ring)")
+    p.add_argument("--eps0", type=float, default=None, help="threshold of the paper's eps rule (default 0.01)")
+    p.add_argument("--maemm-prior", nargs="+", type=float, metavar="MM", default=None,
+                   help="MAEMM prior (mm, one value per pose coordinate) for kappa_m (paper; default: see "
+                        "docs/reproduction.md) or kappa with the prior (ring)")
+    p.add_argument("--optimize", action="store_true", help="optimise the poses instead of the boundary scheme")
+    p.add_argument("--K", type=int, default=None,
+                   help="number of poses (--optimize; default 2n of the scheme's default: 6 paper, 12 ring)")
     p.add_argument("--criterion", choices=["cond", "D", "A", "E", "crlb"], default="crlb",
                    help="design criterion (--optimize)")
-    p.add_argument("--region", nargs=4, type=float, metavar=("XMIN", "XMAX", "YMIN", "YMAX"), default=None,
-                   help="design region in mm (default: the workspace)")
+    p.add_argument("--region", nargs="+", type=float, metavar="MM", default=None,
+                   help="design region in mm (default: the workspace): XMIN XMAX YMIN YMAX on a rectangle, "
+                        "RW ZMIN ZMAX on a cylinder")
     p.add_argument("--seed", type=int, default=0, help="seed of the multi-start")
     p.add_argument("--verify", type=int, default=0, metavar="N", help="Monte Carlo trials to verify the CRLB")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot the poses in the workspace")
@@ -35,8 +54,8 @@ def add_arguments(p):
                    help="l0 bounds the span of rho over all poses (range, default) or each change (consecutive)")
     p.add_argument("--margin", type=float, default=None,
                    help="min |sin| of every transmission angle (--optimize; default: the robot's)")
-    p.add_argument("--joint-limits", nargs=4, type=float, metavar=("LO1", "HI1", "LO2", "HI2"), default=None,
-                   help="joint limits in deg (--optimize; default none)")
+    p.add_argument("--joint-limits", nargs="+", type=float, metavar="DEG", default=None,
+                   help="joint limits in deg, LO HI per joint: LO1 HI1 LO2 HI2 [LO3 HI3] (--optimize; default none)")
     p.add_argument("--min-separation", type=float, default=1.0, metavar="MM",
                    help="min distance between two poses in mm (--optimize; default 1)")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only"], default="paper",
@@ -45,10 +64,19 @@ def add_arguments(p):
 
 
 def run(args):
+    from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.cli._common import check_scheme
+
+    robot = load_robot_arg(args)
     if args.optimize:
         from zerocal_sym.cli import _design_optimize
 
-        return _design_optimize.run(args)
-    from zerocal_sym.cli import _design_paper
+        return _design_optimize.run(args, robot)
+    scheme = check_scheme(robot, args.scheme)
+    if scheme == "paper":
+        from zerocal_sym.cli import _design_paper
 
-    return _design_paper.run(args)
+        return _design_paper.run(args, robot)
+    from zerocal_sym.cli import _design_scheme
+
+    return _design_scheme.run(args, robot)

@@ -12,6 +12,9 @@ Table 2 is read in the paper's frame (ours mirrored about the x axis), which
 reproduces Tables 3-4 "before"; see docs/reproduction.md for what reproduces
 and what does not (the servo error of Eq. 35 dominates the attainable
 accuracy).
+
+It is the paper's study: on a robot of another mechanism (the rotary Delta)
+it is an error -- run ``simulate``/``identify``/``compare --set`` there.
 """
 NAME = "reproduce"
 HELP = "run Table 2's six groups through the loop; Tables 3-6 and Figs. 8-9 vs the paper"
@@ -104,7 +107,11 @@ def run(args):
     from zerocal_sym.paper.reproduction import format_tables, reproduce
     from zerocal_sym.identify.tsvd import identify_tsvd
 
+    from zerocal_sym.cli._common import require_paper_tables
+
     robot = load_robot_arg(args)
+    require_paper_tables(robot, "reproduce", "run 'zerocal compare --set NAME=VALUE ...' (or simulate, identify, "
+                                             "verify) on it instead")
     if args.trials < 1:
         raise ZerocalError(f"--trials must be >= 1, got {args.trials}")
     if args.max_iter < 2:

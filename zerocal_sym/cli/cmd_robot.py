@@ -1,9 +1,16 @@
 """Validate a robot file and print its summary.
 
-Checks positive lengths, units (mm), a reachable workspace (corners and a
-grid), consistent kinematics and the singularity margin; prints the home
-position, the joint angles at the workspace corners and the smallest
-transmission-angle sine found.
+Checks positive lengths, units (mm), a reachable workspace (its corners or
+rims and a grid), consistent kinematics (forward of inverse) and the
+singularity margin; prints the mechanism, the home position, the joint
+angles at the workspace's corners (rims), the range of the joint angles and
+the largest ``|FK(IK(P)) - P|`` over the grid, and the smallest
+transmission-angle sine found.  Any mechanism: the planar robot of the paper
+(``examples/paper_robot.toml``) or the rotary Delta (``examples/delta.toml``).
+
+``--json`` keys: ``home_pose_mm`` (n coordinates), ``mechanism``,
+``joint_range_deg``, ``fk_ik_max_error_mm``, ``corners``, ``geometry_mm``,
+``workspace``, ``workspace_mm``, ``min_transmission_sine``, ``sha256``, ...
 """
 NAME = "robot"
 HELP = "validate a robot file and print its summary"
@@ -16,25 +23,37 @@ def add_arguments(p):
 def run(args):
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.io.files import to_json
+    from zerocal_sym.model.kinematics import fmt_pose as _fmt
     from zerocal_sym.model.robot import validate
+
+    def fmt_pose(p, spec="g"):  # no "-0.000" from round-off
+        return _fmt([round(float(v), 9) + 0.0 for v in p], spec)
 
     robot = load_robot_arg(args)
     s = validate(robot)
+    s["pose_names"] = list(robot.mechanism.pose_names)
+    s["joint_names"] = list(robot.mechanism.joint_names)
     if args.json:
         print(to_json(s))
         return 0
-    print(f"robot {s['name']} ({s['mechanism']}) from {s['source']}")
+    mech = robot.mechanism
+    print(f"robot {s['name']} ({s['mechanism']}: {s['description']}) from {s['source']}")
     g = s["geometry_mm"]
-    print("geometry [mm]: " + ", ".join(f"{k}={g[k]:g}" for k in robot.mechanism.geometry_names))
-    ws = s["workspace_mm"]
-    print(f"workspace [mm]: x in [{ws['x'][0]:g}, {ws['x'][1]:g}], y in [{ws['y'][0]:g}, {ws['y'][1]:g}]")
-    hx, hy = s["home_pose_mm"]
-    print(f"home P0 (theta1=0, theta2=180 deg): ({hx:.3f}, {hy:.3f}) mm")
+    units = mech.geometry_units
+    print("geometry [mm, deg]: " + ", ".join(f"{k}={g[k]:g}{' deg' if units.get(k) == 'rad' else ''}"
+                                             for k in mech.geometry_names))
+    print(f"workspace [mm]: {s['workspace']} {robot.workspace.describe()}")
+    joints = ", ".join(mech.joint_names)
+    home = fmt_pose(s["home_joints_deg"])
+    print(f"home P0 (({joints}) = {home} deg): {fmt_pose(s['home_pose_mm'], '.3f')} mm")
+    w = max(len(label) for label in s["corners"])
     for label, c in s["corners"].items():
-        (x, y), (t1, t2) = c["pose_mm"], c["joints_deg"]
-        print(f"corner {label:12s} ({x:8.3f}, {y:8.3f}) mm -> theta = ({t1:9.4f}, {t2:9.4f}) deg")
-    mx, my = s["min_transmission_sine_at_mm"]
+        print(f"corner {label:{w}s} {fmt_pose(c['pose_mm'], '8.3f')} mm -> ({joints}) = "
+              f"{fmt_pose(c['joints_deg'], '9.4f')} deg")
+    lo, hi = s["joint_range_deg"]
+    print(f"joint angles over the workspace: [{lo:.3f}, {hi:.3f}] deg; max |FK(IK(P)) - P| = "
+          f"{s['fk_ik_max_error_mm']:.3g} mm")
     print(f"singularity margin: min |sin transmission| = {s['min_transmission_sine']:.4f} at "
-          f"({mx:g}, {my:g}) mm (required >= {s['singularity_margin']:g})")
+          f"{fmt_pose(s['min_transmission_sine_at_mm'], '.6g')} mm (required >= {s['singularity_margin']:g})")
     print(f"sha256: {s['sha256']}")
     return 0

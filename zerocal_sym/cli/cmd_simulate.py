@@ -1,70 +1,139 @@
-"""Simulate one identification round of the paper's calibration.
+"""Simulate one identification round of the calibration (any mechanism).
 
-A virtual robot with the source errors of Table 2's group G (read in the
-paper's frame, i.e. ours mirrored about the x axis, unless ``--frame literal``;
-see docs/reproduction.md) is commanded to the paper's 2n poses through the
-nominal inverse kinematics minus the compensation, and the measuring
-mechanism's scale readings are written in the measurement CSV format
-(``zerocal_sym/io/measurements.py``), atomically.
+A virtual robot with the given true source errors is commanded to the
+measurement poses through the nominal inverse kinematics minus the
+compensation, and the measuring mechanism's scale readings are written in
+the measurement CSV format of the robot's mechanism
+(``zerocal_sym/io/measurements.py``: ``theta1_deg, ..., reading_mm, x_mm,
+...``), atomically.
 
-``--compensation`` and the commanded angles in the file are in the robot's
-frame (the frame of the robot file and of identification results).
+True errors (exactly one of):
+
+* ``--set NAME=VALUE`` (repeatable): source errors by name, in the robot's
+  frame, degrees for angles and mm otherwise, the others zero; the names are
+  the robot mechanism's (``zerocal simulate --set help=0`` lists them), e.g.
+  ``--set theta1=2 --set theta2=-1 --set theta3=0.5 --set rMz=0.3``;
+* ``--group G``: Table 2's group G of the paper (its planar robot only),
+  read in the paper's frame, i.e. ours mirrored about the x axis, unless
+  ``--frame literal`` (docs/reproduction.md).
+
+``--group`` and ``--set`` are mutually exclusive: Table 2 is read in the
+paper's frame, ``--set`` in the robot's; to change one value of a group, give
+the group's values by ``--set`` (the file's ``# true_errors:`` line lists
+them).
+
+Poses: the robot's boundary scheme (``--scheme``, default the robot's own:
+the paper's on a rectangular workspace, the ring scheme on a cylinder) with
+``--n`` poses per boundary (default 3 for the paper's scheme, 6 for the
+ring), or ``--poses FILE`` (a pose list, ``[pose,]x_mm,y_mm[,z_mm]``, or the
+JSON of ``zerocal design``).
+
+``--compensation`` (one value per joint, deg) and the commanded angles in
+the file are in the robot's frame (the frame of the robot file and of
+identification results).
+
+Examples:
+
+    zerocal simulate --group 1 --out d.csv
+    zerocal simulate --robot examples/delta.toml --scheme ring --n 6 \\
+        --set theta1=2 --set theta2=-1 --set theta3=0.5 --noise none --out d.csv
 """
 NAME = "simulate"
-HELP = "simulate one identification round (Table 2 group) into a measurement CSV"
+HELP = "simulate one identification round (true errors by --set, or a Table 2 group) into a measurement CSV"
 
 
 def add_arguments(p):
-    p.add_argument("--group", type=int, required=True, help="Table 2 group, 1..6")
+    truth = p.add_mutually_exclusive_group(required=True)
+    truth.add_argument("--set", action="append", default=None, metavar="NAME=VALUE",
+                       help="a true source error (robot frame; deg for angles, mm otherwise), repeatable; "
+                            "not with --group")
+    truth.add_argument("--group", type=int, default=None,
+                       help="Table 2 group 1..6 (the paper's planar robot only); not with --set")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
                    help="noise model (default: paper, Eq. 34 + Eq. 35)")
-    p.add_argument("--n", type=int, default=3, help="poses per boundary (default 3, K = 2n)")
-    p.add_argument("--compensation", nargs=2, type=float, metavar=("D1", "D2"), default=(0.0, 0.0),
-                   help="compensation already applied, deg (robot frame): commanded = IK - compensation")
-    p.add_argument("--frame", choices=["paper", "literal"], default="paper",
-                   help="how Table 2 is read (default: paper = mirrored about x)")
+    poses = p.add_mutually_exclusive_group()
+    poses.add_argument("--scheme", choices=["paper", "ring"], default=None,
+                       help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
+    poses.add_argument("--poses", metavar="FILE", default=None,
+                       help="pose list instead of a scheme: CSV [pose,]x_mm,y_mm[,z_mm] or design JSON")
+    p.add_argument("--n", type=int, default=None,
+                   help="poses per boundary of the scheme, K = 2n (default: 3 paper, 6 ring)")
+    p.add_argument("--compensation", nargs="+", type=float, metavar="DEG", default=None,
+                   help="compensation already applied, one value per joint, deg (robot frame): "
+                        "commanded = IK - compensation")
+    p.add_argument("--frame", choices=["paper", "literal"], default=None,
+                   help="how Table 2 is read with --group (default: paper = mirrored about x)")
     p.add_argument("--out", required=True, metavar="FILE.csv", help="output measurement file")
+
+
+def true_errors(args, robot):
+    """(vector, description, meta) of the true source errors from ``--set`` or ``--group``."""
+    from zerocal_sym.cli._common import parse_named_values, require_paper_tables
+    from zerocal_sym.errors import ZerocalError
+
+    if args.group is not None:
+        from zerocal_sym.paper.tables import group_errors
+
+        require_paper_tables(robot, "--group")
+        frame = args.frame or "paper"
+        err = group_errors(args.group, frame)
+        return err, f"Table 2 group {args.group} in the {frame} frame", {"group": args.group, "frame": frame}
+    if args.frame is not None:
+        raise ZerocalError("--frame is how Table 2 is read: it goes with --group, not --set")
+    values = parse_named_values(args.set, robot, "--set")
+    return robot.errors.from_user(values), "set by --set", {"set": " ".join(args.set)}
 
 
 def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.cli._common import fmt_values, format_named, poses_arg, scheme_poses, vector_arg
+    from zerocal_sym.errors import PoseError
     from zerocal_sym.identify.loop import simulate_round
+    from zerocal_sym.io.compensation import format_offsets
     from zerocal_sym.io.measurements import write_measurements
-    from zerocal_sym.errors import PoseError, ZerocalError
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-    from zerocal_sym.paper.tables import group_errors
-    from zerocal_sym.paper.scheme import paper_poses
 
     robot = load_robot_arg(args)
-    err = group_errors(args.group, args.frame)
-    if args.n < 3:
-        raise PoseError(f"--n {args.n} gives K = {2 * args.n} < 5 poses: too few to identify 4 parameters")
-    comp = np.radians(np.asarray(args.compensation, float))
-    if not np.all(np.isfinite(comp)):
-        raise ZerocalError("--compensation must be finite numbers (deg)")
-    poses = paper_poses(robot, args.n)
-    rng = np.random.default_rng([args.seed, args.group])
-    meas = simulate_round(robot, VirtualPlant(robot, err), poses, comp, NoiseModel.named(args.noise), rng)
+    errors = robot.errors
+    err, what, meta_truth = true_errors(args, robot)
+    joints = robot.mechanism.joint_names
+    comp_deg = np.zeros(robot.m) if args.compensation is None else vector_arg(
+        args.compensation, robot.m, "--compensation", joints, "deg")
+    if args.poses is not None:
+        if args.n is not None:
+            from zerocal_sym.errors import ZerocalError
+
+            raise ZerocalError("--n is the number of poses per boundary of a scheme: not with --poses")
+        poses, pose_what = poses_arg(robot, args.poses, None)
+    else:
+        poses, n = scheme_poses(robot, args.scheme, args.n)
+        pose_what = f"{robot.workspace.scheme_name} scheme, n = {n}"
+    rng = np.random.default_rng([args.seed, args.group] if args.group is not None else [args.seed])
+    meas = simulate_round(robot, VirtualPlant(robot, err), poses, np.radians(comp_deg), NoiseModel.named(args.noise),
+                          rng)
     if not np.all(np.isfinite(meas.readings)):
         raise PoseError("the compensated commands leave the robot's assembly (reading is not finite)")
-    fmt = lambda v: " ".join(f"{x:.10g}" for x in v)  # noqa: E731
+    offsets_deg = np.degrees(errors.take(err, errors.zero_offsets))
+    maemm = errors.take(err, errors.measuring)
     meas.meta = {
         "generator": "zerocal simulate",
         "robot": robot.name,
         "robot_sha256": robot.sha256,
-        "group": args.group,
-        "frame": args.frame,
+        **meta_truth,
         "seed": args.seed,
         "noise": args.noise,
-        "n": args.n,
-        "compensation_deg": fmt(args.compensation),
-        "true_zero_offsets_deg": fmt(np.degrees(err[:2])),
-        "true_maemm_mm": fmt(err[10:12]),
+        "poses": pose_what,
+        "compensation_deg": format_offsets(comp_deg) if args.compensation is not None else fmt_values(comp_deg),
+        "true_zero_offsets_deg": fmt_values(offsets_deg),
+        "true_maemm_mm": fmt_values(maemm),
+        "true_errors": format_named(robot, err).replace(" deg", "").replace(" mm", ""),
     }
-    write_measurements(args.out, meas)
-    print(f"wrote {meas.K} poses of group {args.group} (noise {args.noise}, seed {args.seed}, Table 2 in the "
-          f"{args.frame} frame: true offsets {fmt(np.degrees(err[:2]))} deg in the robot frame) to {args.out}")
+    if args.group is not None:
+        meas.meta["n"] = len(poses) // 2
+    write_measurements(args.out, meas, mechanism=robot)
+    print(f"wrote {meas.K} poses ({pose_what}; noise {args.noise}, seed {args.seed}) to {args.out}; true errors "
+          f"{what}: {format_named(robot, err)} (robot frame)")
     return 0

@@ -1,15 +1,17 @@
 """Verify a compensation by re-identification (the paper's stopping rule).
 
 Measure again with the compensation applied (commands ``IK(P) - offset``:
-``zerocal compensate RESULT.json --scheme paper --template`` gives the sheet;
-``zerocal simulate --compensation D1 D2`` simulates it), then
+``zerocal compensate RESULT.json --scheme paper --template`` gives the sheet
+(``--scheme ring`` on a cylindrical workspace); ``zerocal simulate
+--compensation D1 D2 [D3]`` simulates it), then
 
     zerocal verify RESULT.json ROUND2.csv [--out RESULT2.json]
 
 identifies the offsets again, linearised at the applied compensation and
 MAEMM estimate (paper Eq. 30), and compares: the remaining offset is
 ``new - applied`` and the compensation accuracy
-``mu = sqrt(((new1 - applied1)^2 + (new2 - applied2)^2) / 2)``.  Exit status
+``mu = sqrt(((new1 - applied1)^2 + ... + (newm - appliedm)^2) / m)`` over
+the m joints (the paper's with m = 2).  Exit status
 0 if ``mu < mu0`` (default 0.1 deg, the paper's), 1 if not: then apply the
 new result (``--out``, a results file like identify's) and verify again.
 
@@ -35,29 +37,14 @@ def add_arguments(p):
                    help="write residuals.png (residuals per pose of the re-identification) into DIR")
 
 
-def _declared_compensation(meas):
-    """Compensation the data file says was applied (deg), or None."""
-    import re
-
-    import numpy as np
-
-    text = meas.meta.get("compensation_deg")
-    if text is None:
-        return None
-    vals = [v for v in re.split(r"[,\s]+", text.strip()) if v]
-    try:
-        out = np.array([float(v) for v in vals])
-    except ValueError:
-        return None
-    return out if out.shape == (2,) and np.all(np.isfinite(out)) else None
-
-
 def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.cli.cmd_compensate import check_result_robot
+    from zerocal_sym.cli.cmd_identify import compensation_block
     from zerocal_sym.errors import DataFileError, ZerocalError
-    from zerocal_sym.io.compensation import SIGN_CONVENTION
+    from zerocal_sym.io.compensation import parse_offsets
     from zerocal_sym.io.files import json_safe, to_json, write_json
     from zerocal_sym.io.measurements import load_measurements
     from zerocal_sym.io.results import load_result
@@ -72,23 +59,23 @@ def run(args):
             raise ZerocalError(f"{opt} {path}: {'is a directory' if opt == '--out' else 'is not a directory'}",
                                where=path)
     robot = load_robot_arg(args)
-    applied = load_result(args.result)
-    if applied.robot_sha256 and applied.robot_sha256 != robot.sha256:
-        raise DataFileError(f"identified on another robot (robot_sha256 {applied.robot_sha256[:12]}..., "
-                            f"{robot.sha256[:12]}... for {robot.source}): pass the same --robot", where=args.result)
+    errors = robot.errors
+    joints = robot.mechanism.joint_names
+    applied = load_result(args.result, robot=robot)
+    check_result_robot(applied, robot, args.result)
     meas = load_measurements(args.data, robot)
-    declared = _declared_compensation(meas)
+    declared = parse_offsets(meas.meta.get("compensation_deg"), robot.m)
     if declared is not None and np.max(np.abs(declared - applied.zero_offsets_deg)) > 1e-4:
         line = meas.meta_lines.get("compensation_deg")
+        fmt = lambda v: "(" + ", ".join(f"{x:g}" for x in v) + ")"  # noqa: E731
         raise DataFileError(
-            f"the data were measured with compensation ({declared[0]:g}, {declared[1]:g}) deg, not with the "
-            f"result's offsets ({applied.zero_offsets_deg[0]:g}, {applied.zero_offsets_deg[1]:g}) deg",
+            f"the data were measured with compensation {fmt(declared)} deg, not with the "
+            f"result's offsets {fmt(applied.zero_offsets_deg)} deg",
             where=f"{args.data}:{line}" if line else args.data)
     noise = NoiseModel.named(args.noise)
-    prior = np.zeros(12)
-    prior[:2] = np.radians(applied.zero_offsets_deg)
+    prior = errors.put(errors.zeros(), errors.zero_offsets, np.radians(applied.zero_offsets_deg))
     if np.all(np.isfinite(applied.maemm_mm)):
-        prior[10:12] = applied.maemm_mm
+        prior = errors.put(prior, errors.measuring, applied.maemm_mm)
     if args.method == "tsvd":
         from zerocal_sym.identify.tsvd import identify_tsvd
 
@@ -108,6 +95,7 @@ def run(args):
         "passed": bool(passed),
         "mu_deg": mu,
         "mu0_deg": args.mu0,
+        "joints": list(joints),
         "applied_offsets_deg": applied.zero_offsets_deg.tolist(),
         "new_offsets_deg": new.tolist(),
         "remaining_offsets_deg": remaining.tolist(),
@@ -117,9 +105,8 @@ def run(args):
         "applied_result": str(args.result),
     }
     out = res.to_dict()
-    out.update(robot_sha256=robot.sha256, verification=report,
-               compensation={"sign_convention": SIGN_CONVENTION, "joints": ["theta1", "theta2"],
-                             "offset_deg": new.tolist(), "std_deg": report["std_new_offsets_deg"]})
+    out.update(mechanism=robot.mechanism_name, robot_sha256=robot.sha256, verification=report,
+               compensation=compensation_block(robot, res))
     target = args.plot
     try:
         if args.plot:
@@ -134,10 +121,12 @@ def run(args):
     if args.json:
         print(to_json(json_safe(out)))
     else:
-        print(f"{args.data}: re-identified ({res.method}) with the compensation of {args.result} applied")
-        print(f"  applied   offsets: {applied.zero_offsets_deg[0]:+.4f}, {applied.zero_offsets_deg[1]:+.4f} deg")
-        print(f"  new       offsets: {new[0]:+.4f}, {new[1]:+.4f} deg (std {std[0]:.3g}, {std[1]:.3g})")
-        print(f"  remaining offsets: {remaining[0]:+.4f}, {remaining[1]:+.4f} deg")
+        vec = lambda v: ", ".join(f"{x:+.4f}" for x in v)  # noqa: E731
+        print(f"{args.data}: re-identified ({res.method}) with the compensation of {args.result} applied "
+              f"(joints {', '.join(joints)})")
+        print(f"  applied   offsets: {vec(applied.zero_offsets_deg)} deg")
+        print(f"  new       offsets: {vec(new)} deg (std {', '.join(f'{s:.3g}' for s in std)})")
+        print(f"  remaining offsets: {vec(remaining)} deg")
         verdict = "PASS" if passed else "FAIL: apply the new result and measure again"
         print(f"  mu = {mu:.4f} deg {'<' if passed else '>='} mu0 = {args.mu0:g} deg: {verdict}")
         if args.out:

@@ -23,6 +23,12 @@ P23..P37 between them and P39..P42 between P38 and P1, as the surviving labels
 require; the starting corner and direction follow the paper's measurement
 poses (P1 at ``(-b/2, H)``, then ``+x``).  For other K the positions are
 spaced evenly by arc length from the same corner in the same direction.
+
+On a cylindrical workspace (the rotary Delta) the boundary positions are the
+workspace's own boundary scheme with K/2 positions on each rim
+(``robot.workspace.boundary_scheme(K // 2)``: the top circle at azimuths
+``360 deg j/(K/2)``, then the bottom one).  Everything else here is generic
+over the mechanism: m zero offsets, n pose coordinates.
 """
 from __future__ import annotations
 
@@ -127,11 +133,13 @@ def plot_residuals(result, meas, path, robot=None) -> dict:
 # --------------------------------------------------------------------------- boundary positions (Figs. 11, 12)
 
 def boundary_positions(robot, K: int = 42) -> np.ndarray:
-    """K evenly spaced positions on the workspace boundary (paper Fig. 11).
+    """K positions on the workspace boundary (paper Fig. 11 on a rectangle).
 
-    Numbering as in the module docstring: from the corner ``(-b/2, H)``
-    along ``y = H`` towards ``+x``, up ``x = b/2``, back along ``y = H + h``,
-    down ``x = -b/2``.
+    Rectangle: evenly spaced along the perimeter, numbered as in the module
+    docstring (from the corner ``(-b/2, H)`` along ``y = H`` towards ``+x``,
+    up ``x = b/2``, back along ``y = H + h``, down ``x = -b/2``).  Other
+    shapes (the Delta's cylinder): the workspace's boundary scheme with K/2
+    positions per boundary (K even).
 
     Parameters
     ----------
@@ -141,12 +149,19 @@ def boundary_positions(robot, K: int = 42) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (K, 2)
-        mm; row k is the paper's P(k+1).
+    ndarray, shape (K, n)
+        mm; row k is the paper's P(k+1) on the rectangle.
     """
     if K < 4:
         raise ValueError(f"K must be >= 4, got {K}")
-    x0, x1, y0, y1 = -robot.b / 2, robot.b / 2, robot.H, robot.H + robot.h
+    ws = robot.workspace
+    if ws.kind != "rectangle":
+        if K % 2:
+            raise ValueError(f"K must be even on a {ws.kind} workspace (K/2 per boundary), got {K}")
+        return ws.boundary_scheme(K // 2)
+    lo, hi = ws.bounds()
+    x0, y0 = (float(v) for v in lo)
+    x1, y1 = (float(v) for v in hi)
     corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]])
     seg = np.linalg.norm(np.diff(corners, axis=0), axis=1)
     cum = np.concatenate([[0.0], np.cumsum(seg)])
@@ -175,11 +190,11 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
     ----------
     robot : Robot
         Nominal robot.
-    err_true : ndarray, shape (12,)
+    err_true : ndarray, shape (q,)
         True source errors of the plant (rad, mm).
-    compensation_deg : array_like, shape (2,)
-        Identified zero offsets (the compensation), deg.
-    P : ndarray, shape (K, 2), optional
+    compensation_deg : array_like, shape (m,)
+        Identified zero offsets (the compensation), deg, joint order.
+    P : ndarray, shape (K, n), optional
         Target positions (default :func:`boundary_positions`).
     K : int
         Number of boundary positions if ``P`` is not given.
@@ -187,15 +202,17 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
     Returns
     -------
     dict
-        ``index`` (K,) 1..K, ``P`` (K, 2) mm, ``before_mm`` (K,),
+        ``index`` (K,) 1..K, ``P`` (K, n) mm, ``before_mm`` (K,),
         ``after_mm`` (K,), ``max_before_mm``, ``max_after_mm`` (float),
-        ``compensation_deg`` (2,).
+        ``compensation_deg`` (m,), ``workspace`` (its kind).
     """
     from zerocal_sym.model.noise import VirtualPlant
     from zerocal_sym.identify.loop import position_errors
 
     P = boundary_positions(robot, K) if P is None else np.atleast_2d(np.asarray(P, float))
     comp = np.radians(np.asarray(compensation_deg, float))
+    if comp.shape != (robot.m,):
+        raise ValueError(f"compensation_deg must have one value per joint ({robot.m}), got shape {comp.shape}")
     plant = VirtualPlant(robot, err_true)
     before = position_errors(robot, plant, P)
     after = position_errors(robot, plant, P, comp)
@@ -207,11 +224,12 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
         "max_before_mm": float(np.max(before)),
         "max_after_mm": float(np.max(after)),
         "compensation_deg": np.degrees(comp),
+        "workspace": robot.workspace.kind,
     }
 
 
 def figure_boundary_errors(d: dict, title: str | None = None):
-    """Figure of :func:`boundary_errors`: error vs position index, and the positions."""
+    """Figure of :func:`boundary_errors`: error vs position index, and the positions (3-D: azimuth against z)."""
     fig = _figure((9.0, 3.8))
     gs = fig.add_gridspec(1, 3)
     ax = fig.add_subplot(gs[0, :2])
@@ -225,17 +243,29 @@ def figure_boundary_errors(d: dict, title: str | None = None):
     ax.set_title(title or "Position error over the boundary (Fig. 12 style)")
     ax2 = fig.add_subplot(gs[0, 2])
     P = d["P"]
-    ax2.plot(np.append(P[:, 0], P[0, 0]), np.append(P[:, 1], P[0, 1]), "-", color="0.7", lw=0.8)
-    ax2.scatter(P[:, 0], P[:, 1], c=d["after_mm"], s=12, cmap="viridis")
-    xs, ys = (P[:, 0].min(), P[:, 0].max()), (P[:, 1].min(), P[:, 1].max())
-    corner = [k for k in range(len(P)) if P[k, 0] in xs and P[k, 1] in ys]
-    for k in sorted(set(corner) | {len(P) - 1}):
-        ax2.annotate(f"P{k + 1}", P[k], fontsize=7, xytext=(2, 2), textcoords="offset points")
-    ax2.set_aspect("equal")
-    ax2.invert_yaxis()  # the paper draws the base (y = 0) at the top
-    ax2.set_xlabel("x [mm]")
-    ax2.set_ylabel("y [mm]")
-    ax2.set_title("positions (colour: after)", fontsize=9)
+    if P.shape[1] == 2:
+        ax2.plot(np.append(P[:, 0], P[0, 0]), np.append(P[:, 1], P[0, 1]), "-", color="0.7", lw=0.8)
+        ax2.scatter(P[:, 0], P[:, 1], c=d["after_mm"], s=12, cmap="viridis")
+        xs, ys = (P[:, 0].min(), P[:, 0].max()), (P[:, 1].min(), P[:, 1].max())
+        corner = [k for k in range(len(P)) if P[k, 0] in xs and P[k, 1] in ys]
+        for k in sorted(set(corner) | {len(P) - 1}):
+            ax2.annotate(f"P{k + 1}", P[k], fontsize=7, xytext=(2, 2), textcoords="offset points")
+        ax2.invert_yaxis()  # the paper draws the base (y = 0) at the top
+        ax2.set_ylabel("y [mm]")
+        ax2.set_title("positions (colour: after)", fontsize=9)
+        ax2.set_aspect("equal")
+        ax2.set_xlabel("x [mm]")
+    else:  # 3-D: the positions unrolled, azimuth about z against z
+        az = np.degrees(np.arctan2(P[:, 1], P[:, 0])) % 360.0
+        sc = ax2.scatter(az, P[:, 2], c=d["after_mm"], s=14, cmap="viridis")
+        for k in (0, len(P) - 1):
+            ax2.annotate(f"P{k + 1}", (az[k], P[k, 2]), fontsize=7, xytext=(2, 2), textcoords="offset points")
+        fig.colorbar(sc, ax=ax2, label="after [mm]")
+        ax2.set_xlim(-10, 370)
+        ax2.set_xticks([0, 90, 180, 270, 360])
+        ax2.set_xlabel("azimuth atan2(y, x) [deg]")
+        ax2.set_ylabel("z [mm]")
+        ax2.set_title("positions (colour: after)", fontsize=9)
     return fig
 
 
@@ -262,19 +292,20 @@ def convergence_data(history, set_values_deg=None) -> dict:
     history : LoopResult, sequence or dict
         A :class:`~zerocal_sym.paper.LoopResult` (its ``history``), a sequence
         with one entry per identification round (mappings or objects with
-        ``compensation_deg`` (2,): the compensation value after that round,
+        ``compensation_deg`` (m,): the compensation value after that round,
         i.e. the sum of the increments, deg; or ``compensation`` in rad), or
         the ``history`` dict of :func:`zerocal_sym.paper.run_group` (a dict
         with a list ``compensation_deg``).
-    set_values_deg : array_like, shape (2,), optional
+    set_values_deg : array_like, shape (m,), optional
         True zero offsets (simulation): also ``delta_deg``, the absolute
         difference between the set and the compensation values.
 
     Returns
     -------
     dict
-        ``iteration`` (m,) 1..m, ``compensation_deg`` (m, 2), ``mu_deg`` (m,)
-        (NaN for the first round), ``delta_deg`` (m, 2) or None.
+        ``iteration`` (r,) 1..r over the r rounds, ``compensation_deg`` (r, m)
+        for the m joints, ``mu_deg`` (r,) (RMS of the increment over the
+        joints; NaN for the first round), ``delta_deg`` (r, m) or None.
     """
     if hasattr(history, "history"):
         history = history.history
@@ -284,13 +315,16 @@ def convergence_data(history, set_values_deg=None) -> dict:
     for h in history:
         c = _get(h, "compensation_deg")
         if c is None and _get(h, "compensation") is not None:
-            c = np.degrees(np.asarray(_get(h, "compensation"), float))[:2]
+            c = np.degrees(np.asarray(_get(h, "compensation"), float))
         if c is None:
             raise ValueError("history entries need 'compensation_deg' (deg) or 'compensation' (rad)")
-        comp.append(np.asarray(c, float)[:2])
-    comp = np.array(comp).reshape(-1, 2)
+        comp.append(np.atleast_1d(np.asarray(c, float)))
+    if len({c.shape for c in comp}) > 1:
+        raise ValueError("history entries must all have the same number of joints")
+    m = comp[0].size if comp else 2
+    comp = np.array(comp).reshape(-1, m)
     mu = np.full(len(comp), np.nan)
-    mu[1:] = np.sqrt(np.sum(np.diff(comp, axis=0) ** 2, axis=1) / 2)
+    mu[1:] = np.sqrt(np.sum(np.diff(comp, axis=0) ** 2, axis=1) / m)
     delta = None if set_values_deg is None else np.abs(np.asarray(set_values_deg, float) - comp)
     return {"iteration": np.arange(1, len(comp) + 1), "compensation_deg": comp, "mu_deg": mu, "delta_deg": delta}
 
@@ -300,7 +334,8 @@ def figure_convergence(d: dict, mu0_deg: float = 0.1, set_values_deg=None):
     fig = _figure((7.0, 5.0))
     ax = fig.add_subplot(2, 1, 1)
     m = d["iteration"]
-    for j, mk in ((0, "o-"), (1, "v-")):
+    for j in range(d["compensation_deg"].shape[1]):
+        mk = "ov^sD<>"[j % 7] + "-"
         ax.plot(m, d["compensation_deg"][:, j], mk, ms=4, label=rf"$\Delta\theta_{j + 1}$ compensation")
         if set_values_deg is not None:
             ax.axhline(set_values_deg[j], color=f"C{j}", ls=":", lw=0.8)
@@ -328,20 +363,34 @@ def plot_convergence(history, path, set_values_deg=None, mu0_deg: float = 0.1) -
 
 # --------------------------------------------------------------------------- one call per command
 
-def identify_plots(out_dir, result, meas, robot) -> dict:
-    """The plots of one identification (``zerocal identify --plot DIR``).
+def identify_plots(out_dir, result, meas, robot, err_true=None) -> dict:
+    """The plots of one identification (``zerocal identify --plot DIR``), any mechanism.
 
-    Writes ``residuals.png`` in ``out_dir``.
+    Writes ``residuals.png`` in ``out_dir`` and, if the true source errors
+    are known (simulated data), ``boundary_errors.png``: the position error
+    over the workspace boundary (:func:`boundary_positions`) before and after
+    compensating with the identified zero offsets.
+
+    Parameters
+    ----------
+    err_true : ndarray, shape (q,), optional
+        The plant's true source errors (rad, mm).
 
     Returns
     -------
     dict
-        file name -> the figure's data (:func:`residuals_data`).
+        file name -> the figure's data (:func:`residuals_data`,
+        :func:`boundary_errors`).
     """
     from pathlib import Path
 
     out_dir = Path(out_dir)
-    return {"residuals.png": plot_residuals(result, meas, out_dir / "residuals.png", robot)}
+    out = {"residuals.png": plot_residuals(result, meas, out_dir / "residuals.png", robot)}
+    if err_true is not None:
+        out["boundary_errors.png"] = plot_boundary_errors(
+            robot, err_true, result.zero_offsets_deg, out_dir / "boundary_errors.png",
+            title=f"Boundary position error (simulated truth), {result.method} compensation")
+    return out
 
 
 def reproduce_plots(out_dir, rep: dict, robot=None, K: int = 42) -> dict:
