@@ -1,24 +1,27 @@
-"""Time per Ipopt identification against scipy's least_squares on the same problems, same run.
+"""Time per identification against scipy's least_squares on the same problems, same run.
 
-Problems: one simulated measurement round (Table 2 group 1 read literally, the
-paper's noise) at
+Problems: simulated measurement rounds (Table 2 group 1 read literally, the
+paper's noise) of the paper's robot at
   K = 6  -- the paper's six poses (n = 3), 4 parameters;
   K = 42 -- the 42 boundary positions of the paper's Fig. 11, 4 parameters.
-N rounds each (different noise).  Timed per identification:
+Timed per identification (median over passes of the mean over the rounds):
 
-  ipopt-full    identify_nlls as shipped (TSVD warm start, weights re-evaluated at
-                the solution: two Ipopt solves, covariance, identifiability of the result)
-  ipopt-same    identify_nlls(warm_start=None, reweight=0): exactly scipy's problem,
-                whole function (weights, solve, covariance)
-  ipopt-solver  the cached Ipopt solver call alone on that problem
-  scipy-lm      scipy.optimize.least_squares(method="lm") on the same whitened,
-                scaled residuals and Jacobian (CasADi-evaluated), solver call alone
-  scipy-trf     the same with method="trf"
+  identify       identify_nlls as shipped: Gauss-Newton in one CasADi call, Ipopt
+                 confirms, covariance, rank (the whole function)
+  scipy-lm       scipy.optimize.least_squares(method="lm") on the same whitened,
+                 scaled residuals and Jacobian, ordinary callbacks (numpy in,
+                 CasADi Function __call__, numpy out), solver call alone
+  scipy-lm-zc    the same with zero-copy callbacks (CasADi buffers)
+  batch          identify_batch over all rounds at once (per identification)
 
-Ratios are against scipy-lm of the same run; the answers are compared too.
-Usage: python benchmarks/bench_nlls.py [--rounds N] [--repeat R]
+and the batched path at scale: N = 10,000 identifications at K = 6 in one
+process (one core).  Ratios are against scipy-lm of the same run; the answers
+are compared too (max |ours - scipy| over the offsets, deg).
+
+Usage: python benchmarks/bench_nlls.py [--rounds N] [--repeat R] [--batch N] [--json]
 """
 import argparse
+import json
 import statistics
 import time
 
@@ -26,8 +29,8 @@ import numpy as np
 
 
 def timed(fn, repeat):
-    """Median over ``repeat`` passes of the mean time per call of fn over its data."""
-    fn()  # warm-up (builds and caches the NLP)
+    """Median over ``repeat`` passes of the mean time per call of fn over its data (after a warm-up)."""
+    fn()
     out = []
     for _ in range(repeat):
         t = time.perf_counter()
@@ -40,78 +43,99 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rounds", type=int, default=50, help="simulated rounds per K (default 50)")
     ap.add_argument("--repeat", type=int, default=5, help="timing passes, median reported (default 5)")
+    ap.add_argument("--batch", type=int, default=10000, help="identifications of the batch-at-scale run")
+    ap.add_argument("--json", action="store_true", help="print a JSON list (one entry per K) instead of text")
     args = ap.parse_args()
 
     from scipy.optimize import least_squares
 
+    from zerocal_sym.identify.batch import identify_batch
+    from zerocal_sym.identify.nlls import identify_nlls, residual_problem
+    from zerocal_sym.identify.nlls_problem import FastCall
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.measurements import Measurements
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant
-    from zerocal_sym.identify.nlls import get_problem, identify_nlls, residual_problem
-    from zerocal_sym.report.plots import boundary_positions
     from zerocal_sym.model.robot import paper_robot
     from zerocal_sym.paper.scheme import paper_poses
     from zerocal_sym.paper.tables import table2_errors
+    from zerocal_sym.report.plots import boundary_positions
 
     robot = paper_robot()
     noise = NoiseModel.paper()
     plant = VirtualPlant(robot, table2_errors(1))
-    print(f"{'K':>3s} {'method':13s} {'ms/ident':>9s} {'ratio to scipy-lm':>18s}")
+    rows = []
     for K, poses in ((6, paper_poses(robot, 3)), (42, boundary_positions(robot, 42))):
         th = kin.ik(robot, poses)
         rng = np.random.default_rng(K)
         data = [Measurements(th, plant.measure(th, noise, rng)) for _ in range(args.rounds)]
-        probs = [residual_problem(robot, m, "paper", noise) for m in data]
-        prob = get_problem(robot, K, "paper")
-
-        # the raw solver call, with the parameter vector identify_nlls builds
-        from zerocal_sym.identify import fisher
-        from zerocal_sym.identify.nlls import _weights
-
-        scale = fisher.parameter_scale(robot, "paper")
-        pars = []
-        for m in data:
-            W = _weights(robot, th, noise, np.zeros(12))
-            par = prob.pack(th, robot.geometry, np.zeros(12), m.readings[1:], W, scale, np.zeros(4),
-                            np.zeros((4, 4)))
-            J0 = prob.resfun(np.zeros(4), par)[2].full()
-            par[-1] = 1.0 / np.linalg.norm(J0, 2) ** 2
-            pars.append(par)
-
+        R = np.array([m.readings for m in data])
         res = {}
 
-        def run_full():
-            res["full"] = [identify_nlls(robot, m, "paper", noise=noise) for m in data]
+        def run_identify():
+            res["ours"] = [identify_nlls(robot, m, "paper", noise=noise) for m in data]
             return len(data)
 
-        def run_same():
-            res["same"] = [identify_nlls(robot, m, "paper", noise=noise, warm_start=None, reweight=0) for m in data]
+        def run_batch():
+            res["batch"] = identify_batch(robot, th, R, "paper", noise=noise)
             return len(data)
 
-        def run_solver():
-            res["solver"] = [prob.solver(x0=np.zeros(4), p=p)["x"].full().ravel() / scale for p in pars]
-            return len(data)
+        def scipy_runner(zero_copy):
+            probs = []
+            for m in data:
+                fun, jac, sc = residual_problem(robot, m, "paper", noise, callbacks="fast" if zero_copy else "plain")
+                probs.append((fun, jac, sc))
 
-        def run_scipy(method):
             def f():
-                res[method] = [least_squares(fun, np.zeros(4), jac=jac, method=method, xtol=1e-14, ftol=1e-14,
-                                             gtol=1e-14).x / sc for fun, jac, sc in probs]
+                res["zc" if zero_copy else "lm"] = [
+                    least_squares(fun, np.zeros(4), jac=jac, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14).x / sc
+                    for fun, jac, sc in probs]
                 return len(data)
             return f
 
-        t = {"ipopt-full": timed(run_full, args.repeat), "ipopt-same": timed(run_same, args.repeat),
-             "ipopt-solver": timed(run_solver, args.repeat), "scipy-lm": timed(run_scipy("lm"), args.repeat),
-             "scipy-trf": timed(run_scipy("trf"), args.repeat)}
-        for name, v in t.items():
-            print(f"{K:3d} {name:13s} {1e3 * v:9.3f} {v / t['scipy-lm']:18.2f}")
-        same = np.array([r.estimate for r in res["same"]])
-        d_lm = np.max(np.abs(np.degrees(same[:, :2] - np.array(res["lm"])[:, :2])))
-        d_trf = np.max(np.abs(np.degrees(same[:, :2] - np.array(res["trf"])[:, :2])))
-        d_solver = np.max(np.abs(np.degrees(same[:, :2] - np.array(res["solver"])[:, :2])))
-        fails = sum(not r.success for r in res["full"]) + sum(not r.success for r in res["same"])
-        print(f"    answers: max |Ipopt - scipy-lm| = {d_lm:.2e} deg, |Ipopt - scipy-trf| = {d_trf:.2e} deg, "
-              f"|identify_nlls - raw solver| = {d_solver:.2e} deg; Ipopt failures {fails}; "
-              f"mean Ipopt iterations {np.mean([r.info['iterations'] for r in res['same']]):.1f}")
+        t = {"identify": timed(run_identify, args.repeat), "scipy-lm": timed(scipy_runner(False), args.repeat),
+             "scipy-lm-zc": timed(scipy_runner(True), args.repeat), "batch": timed(run_batch, args.repeat)}
+        ours = np.array([r.estimate for r in res["ours"]])
+        same = np.array([identify_nlls(robot, m, "paper", noise=noise, reweight=0).estimate for m in data])
+        row = {
+            "K": K,
+            "identify_ms": 1e3 * t["identify"],
+            "scipy_lm_ms": 1e3 * t["scipy-lm"],
+            "scipy_lm_zero_copy_ms": 1e3 * t["scipy-lm-zc"],
+            "batch_ms": 1e3 * t["batch"],
+            "speedup": t["scipy-lm"] / t["identify"],
+            "speedup_zero_copy": t["scipy-lm-zc"] / t["identify"],
+            # the same problem as scipy's (weights held at the start): the answers must agree
+            "max_diff_to_scipy_deg": float(np.max(np.abs(np.degrees(same[:, :2] - np.array(res["lm"])[:, :2])))),
+            # the shipped answer (weights at the estimate, their fixed point) against scipy's problem
+            "reweighting_effect_deg": float(np.max(np.abs(np.degrees(ours[:, :2] - same[:, :2])))),
+            "max_diff_batch_deg": float(np.nanmax(np.abs(np.degrees(ours[:, :2] - res["batch"].estimate[:, :2])))),
+            "failures": int(sum(not r.success for r in res["ours"])),
+            "ipopt_iterations_mean": float(np.mean([r.info["iterations"] for r in res["ours"]])),
+        }
+        rows.append(row)
+    # batch at scale: N identifications of K = 6 in one call sequence, one process
+    th = kin.ik(robot, paper_poses(robot, 3))
+    rng = np.random.default_rng(0)
+    R = np.array([plant.measure(th, noise, rng) for _ in range(args.batch)])
+    identify_batch(robot, th, R[:10], "paper", noise=noise)  # warm-up (builds the mapped Function)
+    t0 = time.perf_counter()
+    b = identify_batch(robot, th, R, "paper", noise=noise)
+    scale_run = {"K": 6, "batch_n": args.batch, "batch_total_s": time.perf_counter() - t0,
+                 "batch_confirmed": int(b.confirmed.sum()), "batch_success": int(b.success.sum())}
+    if args.json:
+        print(json.dumps(rows + [scale_run], indent=2))
+        return
+    print(f"{'K':>3s} {'identify ms':>12s} {'scipy-lm ms':>12s} {'scipy-zc ms':>12s} {'batch ms':>9s} "
+          f"{'speedup':>8s} {'vs zc':>6s}  answers")
+    for r in rows:
+        print(f"{r['K']:3d} {r['identify_ms']:12.3f} {r['scipy_lm_ms']:12.3f} {r['scipy_lm_zero_copy_ms']:12.3f} "
+              f"{r['batch_ms']:9.3f} {r['speedup']:8.2f} {r['speedup_zero_copy']:6.2f}  "
+              f"same problem: max |ours - scipy| {r['max_diff_to_scipy_deg']:.1e} deg (reweighting moves the "
+              f"answer {r['reweighting_effect_deg']:.1e} deg), |batch - single| "
+              f"{r['max_diff_batch_deg']:.1e} deg, failures {r['failures']}, Ipopt iterations "
+              f"{r['ipopt_iterations_mean']:.1f}")
+    print(f"batch at scale: {scale_run['batch_n']} identifications at K = 6 in {scale_run['batch_total_s']:.2f} s "
+          f"(one process), confirmed {scale_run['batch_confirmed']}, succeeded {scale_run['batch_success']}")
 
 
 if __name__ == "__main__":

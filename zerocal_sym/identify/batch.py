@@ -19,7 +19,7 @@ import numpy as np
 
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.nlls import GN_STEP_TOL, identify_nlls, noise_terms
-from zerocal_sym.identify.nlls_problem import FastCall, get_problem
+from zerocal_sym.identify.nlls_problem import GN_BLOCKS, FastCall, get_problem
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel
 
@@ -58,6 +58,36 @@ class BatchResult:
 
 
 _FAST: dict = {}
+
+
+def _mapped(prob, n):
+    key = (id(prob), n)
+    if key not in _FAST:
+        _FAST[key] = FastCall(prob.batch(n))
+    return _FAST[key]
+
+
+def _gauss_newton_blocks(prob, z, P):
+    """Blocks of Gauss-Newton over the columns of (z, P), each data set until its last step is small.
+
+    Returns ``z`` (n, p), ``step`` (n,), whitened residuals ``r`` (n, K-1), data Jacobians ``J`` (n, K-1, p).
+    """
+    p, n = z.shape
+    K = prob.K
+    step = np.full(n, np.inf)
+    r = np.full((n, K - 1), np.nan)
+    J = np.full((n, K - 1, p), np.nan)
+    todo = np.arange(n)
+    for _ in range(GN_BLOCKS):  # only the data sets not yet converged go on
+        zk, sk, rk, _, Jk, *_ = _mapped(prob, todo.size)(z[:, todo], P[:, todo])
+        z[:, todo] = zk.reshape(p, todo.size, order="F")
+        step[todo] = np.ravel(sk)
+        r[todo] = rk.reshape(K - 1, todo.size, order="F").T
+        J[todo] = Jk.reshape(K - 1 + p, p, todo.size, order="F").transpose(2, 0, 1)[:, : K - 1]  # [J_1 | J_2 | ...]
+        todo = todo[~(step[todo] < GN_STEP_TOL) & np.all(np.isfinite(z[:, todo]), axis=0)]
+        if not todo.size:
+            break
+    return z.T, step, r, J
 
 
 def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel | None = None,
@@ -99,16 +129,9 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
     confirmed = np.zeros(N, bool)
     for a in range(0, N, CHUNK):
         n = min(CHUNK, N - a)
-        key = (id(prob), n)
-        if key not in _FAST:
-            _FAST[key] = FastCall(prob.batch(n))
         P = np.repeat(par[:, None], n, axis=1)
         P[srows] = readings[a:a + n, 1:].T
-        z, step, r, _, J, *_ = _FAST[key](np.repeat(z0[:, None], n, axis=1), P)
-        z = z.reshape(p, n, order="F").T
-        J = J.reshape(K - 1 + p, p, n, order="F").transpose(2, 0, 1)[:, : K - 1]  # [J_1 | J_2 | ...]
-        r = r.reshape(K - 1, n, order="F").T
-        step = np.ravel(step)
+        z, step, r, J = _gauss_newton_blocks(prob, np.repeat(z0[:, None], n, axis=1), P)
         ok = np.isfinite(step) & (step < GN_STEP_TOL) & np.all(np.isfinite(z), axis=1)
         F = np.einsum("nki,nkj->nij", J, J)
         try:

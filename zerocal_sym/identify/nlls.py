@@ -47,7 +47,7 @@ import numpy as np
 from zerocal_sym.identify import fisher
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.identify.nlls_problem import get_problem
+from zerocal_sym.identify.nlls_problem import FastCall, get_problem
 from zerocal_sym.identify.result import IdentificationResult
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
@@ -217,8 +217,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     solver = prob.solver_for(max_iter)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
     fast = prob.fast
-    z_gn, step, r, rp, J, pred, l, b = (np.array(o) for o in
-                                        fast["gauss_newton" if reweight else "gauss_newton_fixed"](z0, par))
+    z_gn, step, r, rp, J, pred, l, b = prob.run_gauss_newton(z0, par, bool(reweight), GN_STEP_TOL)
     step = float(step[0])
     gn_ok = bool(np.all(np.isfinite(z_gn)) and step < GN_STEP_TOL and np.all(z_gn >= lbx) and np.all(z_gn <= ubx))
     if gn_ok:  # Ipopt confirms the Gauss-Newton point (weights at that point)
@@ -347,12 +346,18 @@ def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequen
     return identify
 
 
-def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None):
+def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
+                     callbacks: str = "plain"):
     """The same whitened, scaled least-squares problem as numpy callables.
 
     For outside solvers (``scipy.optimize.least_squares``) on exactly the
     problem Ipopt solves with ``warm_start=None, reweight=0`` (weights at
     ``prior``, no bounds, no Gaussian prior).
+
+    ``callbacks``: ``"plain"`` calls the CasADi Functions the ordinary way
+    (numpy converted in and out); ``"fast"`` through zero-copy buffers
+    (:class:`~zerocal_sym.identify.nlls_problem.FastCall`; the returned
+    arrays are copies).
 
     Returns
     -------
@@ -372,5 +377,10 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], scale,
                     errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
     l, b = (o.full().ravel() for o in prob.weights(errors.take(prior_q, names) * scale, par))
+    if callbacks == "fast":
+        rfun, jfun = FastCall(prob.rfun), FastCall(prob.jfun)
+        return (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy()), scale
+    if callbacks != "plain":
+        raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
     rfun, jfun = prob.rfun, prob.jfun
     return (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full()), scale

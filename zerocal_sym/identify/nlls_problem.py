@@ -14,10 +14,12 @@ it symbolically:
     the whitened residuals of the changes and of the Gaussian prior, and their
     Jacobian with respect to the scaled parameters, for given ``(l, b)``.
 ``gauss_newton``
-    ``N_GN`` damped Gauss-Newton iterations inside one Function (weights
-    re-evaluated at each iterate, or held at the start), returning the
-    iterate, its residuals and Jacobian and the size of the last step;
-    ``gauss_newton_batch`` is the same mapped over data sets of one design.
+    a block of ``N_GN`` damped Gauss-Newton iterations inside one Function
+    (weights re-evaluated at each iterate, or held at the start), returning
+    the iterate, its residuals and Jacobian and the size of the last step;
+    :meth:`NllsProblem.run_gauss_newton` repeats blocks until the last step
+    is below the tolerance (the planar robot: 2 blocks; the Delta: 3-4);
+    :meth:`NllsProblem.batch` is the block mapped over data sets of one design.
 ``solver``
     Ipopt on ``0.5 c |r(z; l, b)|^2`` with the Gauss-Newton Hessian
     (``hess_lag``), the weights as NLP parameters: the judge of convergence,
@@ -32,8 +34,10 @@ import threading
 
 import numpy as np
 
-#: Gauss-Newton iterations inside one call
-N_GN = 12
+#: Gauss-Newton iterations inside one call (a block); callers repeat blocks until converged
+N_GN = 3
+#: at most this many blocks (N_GN * GN_BLOCKS iterations)
+GN_BLOCKS = 6
 #: Ipopt options (silenced)
 IPOPT_OPTIONS = {
     "ipopt.print_level": 0,
@@ -214,6 +218,21 @@ class NllsProblem:
     @property
     def solver(self):
         return self.solver_for(None)
+
+    def run_gauss_newton(self, z0, par, reweight: bool, tol: float):
+        """Blocks of Gauss-Newton from ``z0`` until the last step is below ``tol`` (at most ``GN_BLOCKS``).
+
+        Returns the outputs of the last block as arrays (copies):
+        ``z, last_step, r, r_prior, J, pred, l, b``.
+        """
+        fast = self.fast["gauss_newton" if reweight else "gauss_newton_fixed"]
+        z = np.asarray(z0, float)
+        for _ in range(GN_BLOCKS):
+            out = [np.array(o) for o in fast(z, par)]
+            z = out[0]
+            if not np.all(np.isfinite(z)) or float(out[1][0]) < tol:
+                break
+        return out
 
     def batch(self, N: int):
         """``gauss_newton`` mapped over N data sets (columns of z0 and of the parameter vector)."""
