@@ -51,7 +51,6 @@ def main():
 
     from zerocal_sym.identify.batch import identify_batch
     from zerocal_sym.identify.nlls import identify_nlls, residual_problem
-    from zerocal_sym.identify.nlls_problem import FastCall
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.measurements import Measurements
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant

@@ -19,7 +19,8 @@ import numpy as np
 
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.nlls import GN_STEP_TOL, identify_nlls, noise_terms
-from zerocal_sym.identify.nlls_problem import GN_BLOCKS, FastCall, get_problem
+from zerocal_sym.identify.nlls_problem import GN_BLOCKS, get_problem
+from zerocal_sym.model.fastcall import FastCall
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel
 

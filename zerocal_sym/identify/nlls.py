@@ -47,7 +47,8 @@ import numpy as np
 from zerocal_sym.identify import fisher
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.identify.nlls_problem import FastCall, get_problem
+from zerocal_sym.identify.nlls_problem import get_problem
+from zerocal_sym.model.fastcall import FastCall
 from zerocal_sym.identify.result import IdentificationResult
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
@@ -356,7 +357,7 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
 
     ``callbacks``: ``"plain"`` calls the CasADi Functions the ordinary way
     (numpy converted in and out); ``"fast"`` through zero-copy buffers
-    (:class:`~zerocal_sym.identify.nlls_problem.FastCall`; the returned
+    (:class:`~zerocal_sym.model.fastcall.FastCall`; the returned
     arrays are copies).
 
     Returns

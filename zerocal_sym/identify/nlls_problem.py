@@ -34,6 +34,8 @@ import threading
 
 import numpy as np
 
+from zerocal_sym.model.fastcall import FastCall
+
 #: Gauss-Newton iterations inside one call (a block); callers repeat blocks until converged
 N_GN = 3
 #: at most this many blocks (N_GN * GN_BLOCKS iterations)
@@ -51,46 +53,6 @@ IPOPT_OPTIONS = {
 
 _CACHE: dict = {}
 _LOCK = threading.Lock()
-
-
-class FastCall:
-    """Zero-copy evaluation of a CasADi Function through its buffer (no numpy <-> DM conversion).
-
-    ``fc(*args)`` copies the arguments into preallocated arrays, runs the
-    Function in place and returns views of its preallocated outputs (dense,
-    column-major; matrices come back as ``(rows, cols)`` arrays).  The
-    outputs are overwritten by the next call: copy what you keep.  One
-    buffer per thread.
-    """
-
-    def __init__(self, f):
-        self.f = f
-        self._local = threading.local()
-        self.out_shapes = [f.size_out(i) for i in range(f.n_out())]
-
-    def _state(self):
-        st = getattr(self._local, "st", None)
-        if st is None:
-            f = self.f
-            buf, trigger = f.buffer()
-            ins = [np.zeros(f.nnz_in(i)) for i in range(f.n_in())]
-            outs = [np.zeros(f.nnz_out(i)) for i in range(f.n_out())]
-            for i, a in enumerate(ins):
-                buf.set_arg(i, memoryview(a))
-            for i, a in enumerate(outs):
-                buf.set_res(i, memoryview(a))
-            st = self._local.st = (buf, trigger, ins, outs)
-        return st
-
-    def __call__(self, *args):
-        buf, trigger, ins, outs = self._state()
-        for a, v in zip(ins, args):
-            a[:] = np.ravel(v, order="F")
-        trigger()
-        return [o.reshape(s, order="F") if s[1] > 1 else o for o, s in zip(outs, self.out_shapes)]
-
-    def stats(self) -> dict:
-        return self._state()[0].stats()
 
 
 def _banded_whiten(r, l, b):

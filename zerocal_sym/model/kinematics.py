@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from zerocal_sym.errors import PoseError
+from zerocal_sym.model.fastcall import mapped
 
 
 def fmt_pose(p, spec: str = "g") -> str:
@@ -30,20 +31,20 @@ def _cols(a, n):
 def _call(robot, fname, *args):
     """Evaluate a generated function column-wise over K poses.
 
-    Array arguments of shape (K, n) are passed as (n, K): CasADi maps the
-    function over the columns.  Returns the outputs as numpy arrays with
-    shape (K, rows, cols).
+    Array arguments of shape (K, n) are passed as (n, K) to the function
+    mapped over K columns (the 1-D arguments shared), through a zero-copy
+    buffer (:mod:`zerocal_sym.model.fastcall`).  Returns the outputs as
+    numpy arrays with shape (K, rows, cols).
     """
-    K = max(np.asarray(a).shape[0] for a in args if np.asarray(a).ndim == 2)
+    arrs = [np.asarray(a, float) for a in args]
+    per_pose = tuple(a.ndim == 2 for a in arrs)
+    K = max(a.shape[0] for a, pp in zip(arrs, per_pose) if pp)
     f = robot.mechanism[fname]
-    ins = [np.asarray(a, float).T if np.asarray(a).ndim == 2 else np.asarray(a, float) for a in args]
-    outs = f(*ins)
-    if not isinstance(outs, tuple):
-        outs = (outs,)
+    outs = mapped(f, K, per_pose)(*[a.T if pp else a for a, pp in zip(arrs, per_pose)])
     res = []
     for k, o in enumerate(outs):
         r, c = f.size_out(k)
-        res.append(o.full().reshape(r, K, c).transpose(1, 0, 2))
+        res.append(np.reshape(o, (r, c * K), order="F").reshape(r, K, c).transpose(1, 0, 2).copy())
     return res
 
 
