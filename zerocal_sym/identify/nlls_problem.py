@@ -137,15 +137,17 @@ class NllsProblem:
         step_rew = ca.Function("gn_step", [z, par], [zn, dn])
 
         def unroll(reweight):
+            # reweight: weights at every iterate; else held at the given (l, b) (the start's)
             z0, pp = ca.MX.sym("z0", p), ca.MX.sym("p", self.npar)
-            lx, bx = self.weights(z0, pp)
+            lx, bx = ca.MX.sym("l", K - 1), ca.MX.sym("b", max(K - 2, 0))
             zk, dk = z0, ca.MX(np.inf)
             for _ in range(N_GN):
                 zk, dk = step_rew(zk, pp) if reweight else step_fixed(zk, pp, lx, bx)
             lk, bk = self.weights(zk, pp) if reweight else (lx, bx)
             rk, rpk, Jk, predk = self.residuals(zk, pp, lk, bk)
-            return ca.Function("gauss_newton", [z0, pp], [zk, dk, rk, rpk, Jk, predk, lk, bk],
-                               ["z0", "p"], ["z", "last_step", "r", "r_prior", "J", "pred", "l", "b"]).expand()
+            ins, names = ([z0, pp], ["z0", "p"]) if reweight else ([z0, pp, lx, bx], ["z0", "p", "l0", "b0"])
+            return ca.Function("gauss_newton", ins, [zk, dk, rk, rpk, Jk, predk, lk, bk],
+                               names, ["z", "last_step", "r", "r_prior", "J", "pred", "l", "b"]).expand()
 
         self.gauss_newton = unroll(True)
         self.gauss_newton_fixed = unroll(False)
@@ -184,13 +186,16 @@ class NllsProblem:
     def run_gauss_newton(self, z0, par, reweight: bool, tol: float):
         """Blocks of Gauss-Newton from ``z0`` until the last step is below ``tol`` (at most ``GN_BLOCKS``).
 
+        Without ``reweight`` the weights stay those at ``z0`` through every block.
+
         Returns the outputs of the last block as arrays (copies):
         ``z, last_step, r, r_prior, J, pred, l, b``.
         """
         fast = self.fast["gauss_newton" if reweight else "gauss_newton_fixed"]
         z = np.asarray(z0, float)
+        fixed = () if reweight else tuple(np.array(o) for o in self.fast["weights"](z, par))
         for _ in range(GN_BLOCKS):
-            out = [np.array(o) for o in fast(z, par)]
+            out = [np.array(o) for o in fast(z, par, *fixed)]
             z = out[0]
             if not np.all(np.isfinite(z)) or float(out[1][0]) < tol:
                 break
