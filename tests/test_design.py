@@ -12,6 +12,7 @@ from zerocal_sym.design import nlp as design_nlp
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.paper import scheme
+from zerocal_sym.identify import linear
 from zerocal_sym.cli import main
 from zerocal_sym.design import DesignError
 from zerocal_sym.model.noise import NoiseModel
@@ -46,7 +47,7 @@ def test_paper_baseline_values(robot):
 def test_odd_k_baseline(robot):
     P = design.paper_baseline(robot, 7)
     assert P.shape == (7, 2)
-    assert np.all(P[:4, 1] == robot.H) and np.all(P[4:, 1] == robot.H + robot.h)
+    assert np.all(P[:4, 1] == robot.workspace.H) and np.all(P[4:, 1] == robot.workspace.H + robot.workspace.h)
     np.testing.assert_allclose(P[:4, 0], np.linspace(-240, 240, 4))
     np.testing.assert_allclose(P[4:, 0], np.linspace(-240, 240, 3))
 
@@ -60,8 +61,8 @@ def test_criteria_match_fisher_and_scheme(robot, cons, seed, K):
     v = design.criterion_values(robot, P, NOISE)
     crlb = fisher.crlb_zero_offsets_deg(robot, th, "paper", NOISE)
     assert v["crlb"] == pytest.approx(np.sqrt(np.mean(crlb ** 2)), rel=1e-7)
-    G, _ = scheme.identification_matrix(robot, P, theta=th)
-    assert v["cond"] == pytest.approx(scheme.condition_number(G), rel=1e-7)
+    G, _ = linear.identification_matrix(robot, P, theta=th)
+    assert v["cond"] == pytest.approx(linear.condition_number(G), rel=1e-7)
     T = np.diag(1 / fisher.parameter_scale(robot, "paper"))
     Fq = T @ fisher.fisher_information(robot, th, "paper", NOISE) @ T
     assert v["D"] == pytest.approx(np.linalg.slogdet(Fq)[1], rel=1e-7, abs=1e-7)

@@ -2,7 +2,11 @@
 
 Constraints
 -----------
-* region: a rectangle (default the workspace), every pose inside;
+* region: the robot's workspace shape (default the workspace itself), every
+  pose inside -- a :class:`Region` (axis-aligned rectangle ``XMIN XMAX YMIN
+  YMAX``) for a rectangular workspace, a :class:`CylinderRegion` (coaxial
+  cylinder ``RW ZMIN ZMAX``: ``x^2 + y^2 <= RW^2``, ``z in [ZMIN, ZMAX]``) for
+  a cylindrical one;
 * scale travel ``l0`` (default 350 mm, the paper's scale range): the reading
   head is zeroed after each measurement but it is physically attached to the
   mechanism, so its position along the scale is ``rho`` (up to a constant);
@@ -10,9 +14,11 @@ Constraints
   (``travel_mode="range"``, default).  ``travel_mode="consecutive"``
   instead bounds ``|rho_{k+1} - rho_k| <= l0`` (a head re-clamped between
   measurements);
-* singularity margin: every ``|sin|`` of a transmission angle at least
-  ``singularity_margin`` (default: the robot's, 0.2);
-* optional joint limits (deg) on the inverse-kinematics angles;
+* singularity margin: every ``|sin|`` of a transmission angle (every
+  singularity indicator of the mechanism) at least ``singularity_margin``
+  (default: the robot's, 0.2);
+* optional joint limits (deg) on the inverse-kinematics angles, one
+  ``(lo, hi)`` per joint, shape (m, 2);
 * distinct poses: pairwise distance at least ``min_separation_mm`` (default
   1 mm; the data loader rejects repeated poses).
 """
@@ -24,9 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model.kinematics import fmt_pose
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.design.terms import _call_ik, pose_terms
+from zerocal_sym.design.terms import _call_ik, _reachable, design_params, pose_terms
 
+#: smallest K for the planar robot (p = 4 parameters; in general p + 1, see :func:`min_k`)
 MIN_K = 5
 #: largest K accepted (design time grows roughly as K^2: ~15 s at K = 40 with 3 starts)
 MAX_K = 100
@@ -34,26 +42,34 @@ MAX_K = 100
 SCALE_RANGE_MM = 350.0
 TRAVEL_MODES = ("range", "consecutive")
 _FEAS_TOL = 1e-6
+#: tolerance of the pointwise checks (poses computed on a rim, rw cos t, may be 1e-13 mm outside)
+_POINT_TOL = 1e-9
 
 
 class DesignError(ZerocalError):
     """A design request that cannot be met (bad K, region, criterion, constraints)."""
 
 
-# --------------------------------------------------------------------------- constraints
+# --------------------------------------------------------------------------- regions
 @dataclass(frozen=True)
 class Region:
-    """Axis-aligned design region, mm: ``x in [xmin, xmax]``, ``y in [ymin, ymax]``."""
+    """Axis-aligned design region of a rectangular workspace, mm: ``x in [xmin, xmax]``, ``y in [ymin, ymax]``."""
 
     xmin: float
     xmax: float
     ymin: float
     ymax: float
+    kind = "rectangle"
+    n = 2
+    #: the numbers a user gives (``--region``)
+    arg_names = ("XMIN", "XMAX", "YMIN", "YMAX")
+    #: default candidate grid of the exchange (nx, ny)
+    default_grid = (25, 11)
 
     @classmethod
-    def workspace(cls, robot) -> "Region":
-        lo, hi = robot.workspace_bounds()
-        return cls(float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]))
+    def workspace(cls, robot):
+        """The robot's workspace as a design region (a :class:`CylinderRegion` for a cylinder)."""
+        return workspace_region(robot)
 
     @property
     def lo(self):
@@ -67,10 +83,12 @@ class Region:
 
     @property
     def center(self):
+        """Centre of the bounding box, shape (n,)."""
         return (self.lo + self.hi) / 2
 
     @property
     def half(self):
+        """Half sizes of the bounding box, shape (n,)."""
         return (self.hi - self.lo) / 2
 
     def grid(self, nx: int, ny: int):
@@ -78,29 +96,210 @@ class Region:
         X, Y = np.meshgrid(np.linspace(self.xmin, self.xmax, nx), np.linspace(self.ymin, self.ymax, ny))
         return np.column_stack([X.ravel(), Y.ravel()])
 
+    def reach_grid(self):
+        """Points checked for reachability (21 x 21 grid), shape (N, 2)."""
+        return self.grid(21, 21)
+
+    def contains(self, P, tol: float = _FEAS_TOL) -> np.ndarray:
+        """Bool per pose, shape (K,)."""
+        P = np.atleast_2d(P)
+        return np.all((P >= self.lo - tol) & (P <= self.hi + tol), axis=1)
+
+    def sample(self, rng, N: int) -> np.ndarray:
+        """N uniform random points in the region, shape (N, 2)."""
+        return self.lo + rng.uniform(size=(N, 2)) * (self.hi - self.lo)
+
+    def boundary_scheme(self, n1: int, n2: int | None = None) -> np.ndarray:
+        """The paper's rule on the region's edges: n1 poses on ``y = ymin`` then n2 on ``y = ymax``.
+
+        Each edge from ``xmin`` to ``xmax``, evenly spaced (``n2 = n1``: the
+        paper's scheme, :meth:`zerocal_sym.model.workspace.Rectangle.boundary_scheme`).
+
+        Returns
+        -------
+        ndarray, shape (n1 + n2, 2)
+        """
+        n2 = n1 if n2 is None else n2
+        return np.vstack([np.column_stack([np.linspace(self.xmin, self.xmax, n1), np.full(n1, self.ymin)]),
+                          np.column_stack([np.linspace(self.xmin, self.xmax, n2), np.full(n2, self.ymax)])])
+
+    def describe(self) -> str:
+        return f"x in [{self.xmin:g}, {self.xmax:g}], y in [{self.ymin:g}, {self.ymax:g}]"
+
     def as_list(self):
         return [self.xmin, self.xmax, self.ymin, self.ymax]
 
+    def _check(self):
+        if not self.xmax - self.xmin >= 1.0 or not self.ymax - self.ymin >= 1.0:
+            raise DesignError(f"region {self.describe()} mm is empty or thinner than 1 mm (need XMIN < XMAX and "
+                              "YMIN < YMAX; order: XMIN XMAX YMIN YMAX)")
 
+
+@dataclass(frozen=True)
+class CylinderRegion:
+    """Design region of a cylindrical workspace, mm: ``x^2 + y^2 <= rw^2``, ``z in [zmin, zmax]`` (on the z axis)."""
+
+    rw: float
+    zmin: float
+    zmax: float
+    kind = "cylinder"
+    n = 3
+    arg_names = ("RW", "ZMIN", "ZMAX")
+    #: default candidate grid of the exchange (rings, points on the rim, levels)
+    default_grid = (4, 24, 5)
+
+    @classmethod
+    def workspace(cls, robot):
+        return workspace_region(robot)
+
+    @property
+    def lo(self):
+        """Bounding box, shape (3,)."""
+        return np.array([-self.rw, -self.rw, self.zmin])
+
+    @property
+    def hi(self):
+        """Bounding box, shape (3,)."""
+        return np.array([self.rw, self.rw, self.zmax])
+
+    @property
+    def center(self):
+        return (self.lo + self.hi) / 2
+
+    @property
+    def half(self):
+        return (self.hi - self.lo) / 2
+
+    def grid(self, nr: int = 4, na: int = 24, nz: int = 5):
+        """Polar grid, shape (N, 3): on each of ``nz`` levels the axis and ``nr`` rings.
+
+        Ring j (radius ``rw j / nr``) has ``max(4, round(na j / nr))`` points
+        from azimuth 0 (the rim ``na``), so the points are about evenly spread.
+        """
+        pts = []
+        for z in np.linspace(self.zmin, self.zmax, nz):
+            pts.append((0.0, 0.0, z))
+            for j in range(1, nr + 1):
+                rad = self.rw * j / nr
+                na_j = max(4, int(round(na * j / nr)))
+                for t in 2 * np.pi * np.arange(na_j) / na_j:
+                    pts.append((rad * np.cos(t), rad * np.sin(t), z))
+        return np.array(pts)
+
+    def reach_grid(self):
+        """Points checked for reachability (6 rings, 36 on the rim, 9 levels), shape (N, 3)."""
+        return self.grid(6, 36, 9)
+
+    def contains(self, P, tol: float = _FEAS_TOL) -> np.ndarray:
+        P = np.atleast_2d(P)
+        return ((np.hypot(P[:, 0], P[:, 1]) <= self.rw + tol)
+                & (P[:, 2] >= self.zmin - tol) & (P[:, 2] <= self.zmax + tol))
+
+    def sample(self, rng, N: int) -> np.ndarray:
+        """N uniform random points in the cylinder, shape (N, 3)."""
+        u = rng.uniform(size=(N, 3))
+        rad, t = self.rw * np.sqrt(u[:, 0]), 2 * np.pi * u[:, 1]
+        return np.column_stack([rad * np.cos(t), rad * np.sin(t), self.zmin + u[:, 2] * (self.zmax - self.zmin)])
+
+    def boundary_scheme(self, n1: int, n2: int | None = None) -> np.ndarray:
+        """The ring scheme on the region: n1 poses on the top circle (``z = zmax``), then n2 on the bottom one.
+
+        Azimuths ``360 deg j / n`` on each circle, radius ``rw`` (``n2 = n1``:
+        :meth:`zerocal_sym.model.workspace.Cylinder.boundary_scheme`).
+
+        Returns
+        -------
+        ndarray, shape (n1 + n2, 3)
+        """
+        n2 = n1 if n2 is None else n2
+
+        def ring(k, z):
+            t = 2 * np.pi * np.arange(k) / k
+            return np.column_stack([self.rw * np.cos(t), self.rw * np.sin(t), np.full(k, z)])
+
+        return np.vstack([ring(n1, self.zmax), ring(n2, self.zmin)])
+
+    def describe(self) -> str:
+        return f"x^2 + y^2 <= {self.rw:g}^2, z in [{self.zmin:g}, {self.zmax:g}]"
+
+    def as_list(self):
+        return [self.rw, self.zmin, self.zmax]
+
+    def _check(self):
+        if not self.rw >= 1.0 or not self.zmax - self.zmin >= 1.0:
+            raise DesignError(f"region {self.describe()} mm is empty or thinner than 1 mm (need RW >= 1 and "
+                              "ZMIN < ZMAX; order: RW ZMIN ZMAX)")
+
+
+#: workspace kind -> design region class
+REGIONS = {"rectangle": Region, "cylinder": CylinderRegion}
+
+
+def workspace_region(robot):
+    """The robot's workspace as a design region (:class:`Region` or :class:`CylinderRegion`)."""
+    ws = robot.workspace
+    if ws.kind == "rectangle":
+        lo, hi = ws.bounds()
+        return Region(float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]))
+    if ws.kind == "cylinder":
+        lo, hi = ws.bounds()
+        return CylinderRegion(float(ws.rw), float(lo[2]), float(hi[2]))
+    raise DesignError(f"no design region for a {ws.kind} workspace (known: {', '.join(REGIONS)})")
+
+
+def make_region(robot, region=None):
+    """A validated design region of the robot's workspace shape.
+
+    Parameters
+    ----------
+    region : Region, CylinderRegion or sequence of numbers (mm), optional
+        ``XMIN XMAX YMIN YMAX`` for a rectangular workspace, ``RW ZMIN ZMAX``
+        for a cylindrical one; default the workspace.
+
+    Raises
+    ------
+    DesignError
+    """
+    if region is None:
+        return workspace_region(robot)
+    kind = robot.workspace.kind
+    cls = REGIONS.get(kind)
+    if cls is None:
+        raise DesignError(f"no design region for a {kind} workspace (known: {', '.join(REGIONS)})")
+    if isinstance(region, tuple(REGIONS.values())):
+        if not isinstance(region, cls):
+            raise DesignError(f"a {region.kind} region does not fit robot {robot.name!r} (its workspace is a {kind})")
+    else:
+        vals = list(region)
+        names = cls.arg_names
+        if len(vals) != len(names):
+            raise DesignError(f"region needs {len(names)} numbers {' '.join(names)} (mm) for a {kind} workspace, "
+                              f"got {len(vals)}")
+        region = cls(*[_finite(nm, v) for nm, v in zip(names, vals)])
+    region._check()
+    return region
+
+
+# --------------------------------------------------------------------------- constraints
 @dataclass(frozen=True)
 class Constraints:
     """What a design must respect (see the module docstring).
 
     Attributes
     ----------
-    region : Region
+    region : Region or CylinderRegion
     travel_mm : float
         Scale range ``l0``, mm.
     travel_mode : {"range", "consecutive"}
     singularity_margin : float
         Lower bound on every ``|sin|`` of a transmission angle.
-    joint_limits_deg : tuple of two (lo, hi) pairs or None
-        Limits of ``theta1`` and ``theta2``, deg.
+    joint_limits_deg : tuple of m (lo, hi) pairs or None
+        Limits of the joints in the mechanism's order, deg.
     min_separation_mm : float
         Lower bound on the distance between any two poses, mm.
     """
 
-    region: Region
+    region: Region | CylinderRegion
     travel_mm: float = SCALE_RANGE_MM
     travel_mode: str = "range"
     singularity_margin: float = 0.2
@@ -108,7 +307,8 @@ class Constraints:
     min_separation_mm: float = 1.0
 
     def to_dict(self):
-        return {"region_mm": self.region.as_list(), "travel_mm": self.travel_mm, "travel_mode": self.travel_mode,
+        return {"region_kind": self.region.kind, "region_mm": self.region.as_list(),
+                "region": self.region.describe(), "travel_mm": self.travel_mm, "travel_mode": self.travel_mode,
                 "singularity_margin": self.singularity_margin,
                 "joint_limits_deg": None if self.joint_limits_deg is None else [list(j) for j in self.joint_limits_deg],
                 "min_separation_mm": self.min_separation_mm}
@@ -131,15 +331,17 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     Parameters
     ----------
     robot : Robot
-    region : Region or sequence (xmin, xmax, ymin, ymax) in mm, optional
+    region : Region, CylinderRegion or sequence of numbers in mm, optional
+        ``(XMIN, XMAX, YMIN, YMAX)`` for a rectangular workspace,
+        ``(RW, ZMIN, ZMAX)`` for a cylindrical one (:func:`make_region`).
         Default: the robot's workspace.  It must be reachable everywhere (a
-        21 x 21 grid is checked: inverse kinematics defined and consistent with
+        grid is checked: inverse kinematics defined and consistent with
         forward kinematics, i.e. one assembly mode).
     travel_mm : float
     travel_mode : {"range", "consecutive"}
     singularity_margin : float, optional
         Default ``robot.singularity_margin``.
-    joint_limits_deg : ((lo1, hi1), (lo2, hi2)), optional
+    joint_limits_deg : sequence of m (lo, hi) pairs, deg, optional
     min_separation_mm : float
 
     Raises
@@ -147,18 +349,7 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     DesignError
         With a message saying what is wrong.
     """
-    if region is None:
-        region = Region.workspace(robot)
-    elif not isinstance(region, Region):
-        vals = list(region)
-        if len(vals) != 4:
-            raise DesignError(f"region needs 4 numbers XMIN XMAX YMIN YMAX (mm), got {len(vals)}")
-        vals = [_finite(n, v) for n, v in zip(("XMIN", "XMAX", "YMIN", "YMAX"), vals)]
-        region = Region(*vals)
-    if not region.xmax - region.xmin >= 1.0 or not region.ymax - region.ymin >= 1.0:
-        raise DesignError(f"region x in [{region.xmin:g}, {region.xmax:g}], y in [{region.ymin:g}, "
-                          f"{region.ymax:g}] mm is empty or thinner than 1 mm (need XMIN < XMAX and "
-                          "YMIN < YMAX; order: XMIN XMAX YMIN YMAX)")
+    region = make_region(robot, region)
     travel_mm = _finite("travel (scale range l0, mm)", travel_mm)
     if travel_mm <= 0:
         raise DesignError(f"the scale range l0 must be positive, got {travel_mm:g} mm")
@@ -169,9 +360,15 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     if not 0 <= margin < 1:
         raise DesignError(f"singularity margin must be in [0, 1) (a |sin|), got {margin:g}")
     if joint_limits_deg is not None:
-        jl = np.asarray(joint_limits_deg, dtype=float)
-        if jl.shape != (2, 2) or not np.all(np.isfinite(jl)):
-            raise DesignError("joint limits must be ((lo1, hi1), (lo2, hi2)) in degrees, finite")
+        m = robot.m
+        try:
+            jl = np.asarray(joint_limits_deg, dtype=float)
+        except (TypeError, ValueError):
+            jl = None
+        if jl is None or jl.shape != (m, 2) or not np.all(np.isfinite(jl)):
+            pairs = ", ".join(f"(lo{i + 1}, hi{i + 1})" for i in range(m))
+            raise DesignError(f"joint limits must be ({pairs}) in degrees, finite, one pair per joint "
+                              f"({', '.join(robot.mechanism.joint_names)})")
         if np.any(jl[:, 0] >= jl[:, 1]):
             raise DesignError(f"joint limits need lo < hi, got {jl.tolist()} deg")
         joint_limits_deg = tuple(tuple(float(v) for v in row) for row in jl)
@@ -183,22 +380,18 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     return cons
 
 
-def _check_region_reachable(robot, region: Region, n: int = 21):
-    grid = region.grid(n, n)
+def _check_region_reachable(robot, region):
+    grid = region.reach_grid()
     th, ratio = _call_ik(robot, grid)
-    bad = np.flatnonzero(~np.all(np.abs(ratio) <= 1.0, axis=1) | ~np.all(np.isfinite(th), axis=1))
-    lo, hi = Region.workspace(robot).lo, Region.workspace(robot).hi
-    ws = (f"the robot's workspace is x in [{lo[0]:g}, {hi[0]:g}], y in [{lo[1]:g}, {hi[1]:g}] mm")
+    bad = np.flatnonzero(~_reachable(ratio, th))
+    ws = f"the robot's workspace is {robot.workspace.describe()} mm"
     if bad.size:
-        x, y = grid[bad[0]]
-        raise DesignError(f"region x in [{region.xmin:g}, {region.xmax:g}], y in [{region.ymin:g}, "
-                          f"{region.ymax:g}] mm is not reachable: ({x:g}, {y:g}) mm cannot be reached "
-                          f"({bad.size} of {len(grid)} grid points unreachable); {ws}")
+        raise DesignError(f"region {region.describe()} mm is not reachable: {fmt_pose(grid[bad[0]])} mm cannot "
+                          f"be reached ({bad.size} of {len(grid)} grid points unreachable); {ws}")
     back = kin.fk(robot, th)
     off = np.flatnonzero(~(np.linalg.norm(back - grid, axis=1) < 1e-6))
     if off.size:
-        x, y = grid[off[0]]
-        raise DesignError(f"region crosses an assembly-mode change at ({x:g}, {y:g}) mm "
+        raise DesignError(f"region crosses an assembly-mode change at {fmt_pose(grid[off[0]])} mm "
                           f"(forward and inverse kinematics disagree there); {ws}")
 
 
@@ -207,7 +400,7 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
 
     Parameters
     ----------
-    P : ndarray, shape (K, 2)
+    P : ndarray, shape (K, n)
         Poses in visiting order, mm.
     tol : float
         Tolerance (mm, or |sin|, or deg).
@@ -219,14 +412,13 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
     P = np.atleast_2d(np.asarray(P, float))
     out = []
     r = cons.region
-    for k, p in enumerate(P):
-        if np.any(p < r.lo - tol) or np.any(p > r.hi + tol):
-            out.append(f"pose {k} ({p[0]:.3f}, {p[1]:.3f}) mm is outside the region "
-                       f"x in [{r.xmin:g}, {r.xmax:g}], y in [{r.ymin:g}, {r.ymax:g}]")
+    inside = r.contains(P, tol)
+    for k in np.flatnonzero(~inside):
+        out.append(f"pose {k} {fmt_pose(np.round(P[k], 3))} mm is outside the region {r.describe()}")
     th, ratio = _call_ik(robot, P)
-    unreach = ~np.all(np.abs(ratio) <= 1.0, axis=1)
+    unreach = ~_reachable(ratio, th)
     for k in np.flatnonzero(unreach):
-        out.append(f"pose {k} is unreachable")
+        out.append(f"pose {k} {fmt_pose(np.round(P[k], 3))} mm is unreachable")
     if np.any(unreach):
         return out
     t = pose_terms(robot, P)
@@ -236,10 +428,11 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
     if cons.joint_limits_deg is not None:
         jl = np.asarray(cons.joint_limits_deg)
         deg = np.degrees(t["theta"])
+        names = robot.mechanism.joint_names
         for k in range(len(P)):
-            for i in range(2):
+            for i, name in enumerate(names):
                 if deg[k, i] < jl[i, 0] - tol or deg[k, i] > jl[i, 1] + tol:
-                    out.append(f"pose {k}: theta{i + 1} = {deg[k, i]:.4f} deg outside [{jl[i, 0]:g}, {jl[i, 1]:g}]")
+                    out.append(f"pose {k}: {name} = {deg[k, i]:.4f} deg outside [{jl[i, 0]:g}, {jl[i, 1]:g}]")
     rho = t["rho"]
     if cons.travel_mode == "range":
         if np.ptp(rho) > cons.travel_mm + tol:
@@ -262,7 +455,7 @@ def _pointwise_ok(robot, P, cons: Constraints):
     """Per-pose feasibility (region, reach, margin, joint limits), bool shape (K,)."""
     P = np.atleast_2d(P)
     th, ratio = _call_ik(robot, P)
-    ok = np.all(np.abs(ratio) <= 1.0 - 1e-9, axis=1) & np.all((P >= cons.region.lo) & (P <= cons.region.hi), axis=1)
+    ok = _reachable(ratio, th, 1e-9) & cons.region.contains(P, _POINT_TOL)
     if not np.any(ok):
         return ok
     t = pose_terms(robot, P[ok])
@@ -311,11 +504,19 @@ def _travel_ok(rho, cons):
     return np.all(np.abs(np.diff(rho)) <= cons.travel_mm)
 
 
-def _check_k(K):
+def min_k(robot=None) -> int:
+    """Smallest K: ``p + 1`` poses for the p = m + n parameters (K - 1 >= p changes); :data:`MIN_K` without a robot."""
+    return MIN_K if robot is None else max(MIN_K, len(design_params(robot)) + 1)
+
+
+def _check_k(K, robot=None):
+    """Raise :class:`DesignError` unless K is an integer in [:func:`min_k`, :data:`MAX_K`]."""
     if isinstance(K, bool) or not isinstance(K, (int, np.integer)):
         raise DesignError(f"K must be an integer number of poses, got {K!r}")
-    if K < MIN_K:
-        raise DesignError(f"K = {K} is too small: at least {MIN_K} poses are needed to identify the 4 "
-                          "parameters (K - 1 >= 4 measured changes)")
+    kmin = min_k(robot)
+    p = kmin - 1 if robot is not None else 4
+    if K < kmin:
+        raise DesignError(f"K = {K} is too small: at least {kmin} poses are needed to identify the {p} "
+                          f"parameters (K - 1 >= {p} measured changes)")
     if K > MAX_K:
         raise DesignError(f"K = {K} is too large (at most {MAX_K})")

@@ -13,18 +13,23 @@ import numpy as np
 from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, _feasible_random_subset,
                                             _pointwise_ok, make_constraints)
 from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective_batch, _user_value
-from zerocal_sym.design.terms import _qscale, pose_terms
+from zerocal_sym.design.terms import _crlb_weights, _qscale, pose_terms
 
 
 # --------------------------------------------------------------------------- discrete exchange
-def candidate_grid(robot, cons: Constraints, nx: int = 25, ny: int = 11):
-    """Feasible candidate poses on a grid over the region, ndarray shape (N, 2)."""
-    grid = cons.region.grid(nx, ny)
-    return grid[_pointwise_ok(robot, grid, cons)]
+def candidate_grid(robot, cons: Constraints, *grid):
+    """Feasible candidate poses on a grid over the region, ndarray shape (N, n).
+
+    ``grid``: the region's grid sizes -- ``nx, ny`` for a rectangle (default
+    25 x 11), ``nr, na, nz`` (rings, points on the rim, levels) for a cylinder
+    (default 4, 24, 5); none for the region's default.
+    """
+    pts = cons.region.grid(*(grid or cons.region.default_grid))
+    return pts[_pointwise_ok(robot, pts, cons)]
 
 
 def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                    n_starts: int = 8, grid=(25, 11), max_sweeps: int = 50):
+                    n_starts: int = 8, grid=None, max_sweeps: int = 50):
     """Discrete coordinate exchange over a candidate grid.
 
     Each start is a random ordered set of K distinct feasible candidates
@@ -32,23 +37,32 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
     keeps the best improvement (Fedorov-type exchange, one slot at a time);
     sweeps repeat until none improves.
 
+    Parameters
+    ----------
+    grid : tuple of int, optional
+        Candidate grid (:func:`candidate_grid`); default the region's
+        (25 x 11 on a rectangle, 4 rings / 24 on the rim / 5 levels on a
+        cylinder).
+
     Returns
     -------
     dict
-        ``poses`` (K, 2), ``objective``, ``value`` (user units), ``starts``
+        ``poses`` (K, n), ``objective``, ``value`` (user units), ``starts``
         (list of per-start objectives), ``n_candidates``, ``time_s``.
     """
     t0 = time.perf_counter()
     cons = cons or make_constraints(robot)
-    _check_k(K)
+    _check_k(K, robot)
     _check_criterion(criterion)
+    grid = tuple(grid or cons.region.default_grid)
     cand = candidate_grid(robot, cons, *grid)
     if len(cand) < K:
-        raise DesignError(f"only {len(cand)} feasible candidate poses in the region on a {grid[0]} x {grid[1]} "
-                          f"grid (K = {K} needed): relax the singularity margin or joint limits, or enlarge "
-                          "the region")
+        raise DesignError(f"only {len(cand)} feasible candidate poses in the region on a "
+                          f"{' x '.join(str(g) for g in grid)} grid (K = {K} needed): relax the singularity "
+                          "margin or joint limits, or enlarge the region")
     sm2, sx2 = _noise_terms(noise)
     qs = _qscale(robot)
+    wc = _crlb_weights(robot)
     t = pose_terms(robot, cand)
     aq_all = t["a"] * qs
     v_all = sx2 * np.sum(t["dth"] ** 2, axis=1)
@@ -65,14 +79,14 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         if idx is None:
             raise DesignError(f"no {K} candidate poses fit the scale travel l0 = {cons.travel_mm:g} mm "
                               f"({cons.travel_mode}) and the minimum separation {cons.min_separation_mm:g} mm")
-        cur = _objective_batch(criterion, aq_all[idx][None], v_all[idx][None], sm2, qs)[0]
+        cur = _objective_batch(criterion, aq_all[idx][None], v_all[idx][None], sm2, wc)[0]
         for _sweep in range(max_sweeps):
             improved = False
             for pos in rng.permutation(K):
                 free = np.setdiff1d(np.arange(N), idx)
                 trial = np.repeat(idx[None], len(free), axis=0)
                 trial[:, pos] = free
-                o = _objective_batch(criterion, aq_all[trial], v_all[trial], sm2, qs)
+                o = _objective_batch(criterion, aq_all[trial], v_all[trial], sm2, wc)
                 if cons.travel_mode == "range":
                     o[np.ptp(rho[trial], axis=1) > cons.travel_mm] = np.inf
                 else:

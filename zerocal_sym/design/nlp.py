@@ -1,26 +1,31 @@
 """Continuous design: the Ipopt NLP over the K poses (:func:`continuous_design`).
 
-The K poses (scaled to ``[-1, 1]^2`` over the design region) are the
-decision variables of a CasADi/Ipopt NLP built symbolically from the
+The K poses (scaled to ``[-1, 1]^n`` over the design region's bounding box)
+are the decision variables of a CasADi/Ipopt NLP built symbolically from the
 generated mechanism functions; multi-start from seeded random feasible
-designs and from given starts (the paper's scheme).
+designs and from given starts (the boundary scheme).  The region is a box
+(variable bounds) or a cylinder (``x^2 + y^2 <= rw^2`` as a nonlinear
+constraint, ``z`` by bounds).
 
 Smooth reformulations (NLP): ``D``, ``A`` and ``crlb`` are smooth as they
-stand (log det, log trace of the symbolic 4 x 4 inverse).  ``E`` and ``cond``
+stand (log det, log trace of the symbolic p x p inverse, p = m + n).  ``E`` and ``cond``
 are non-smooth where eigenvalues coalesce, so they use auxiliary variables
 and LMI-free eigenvalue constraints: ``max log t`` s.t. ``F_n - t I >= 0``,
 and ``min log(t_hi / t_lo) / 2`` s.t. ``M - t_lo I >= 0``, ``t_hi I - M >= 0``
 (``F_n``, ``M = G^T G`` normalised by their mean eigenvalue at a reference
-design; ``kappa = sqrt(t_hi / t_lo)`` at the optimum).  A 4 x 4 matrix
-inequality ``X >= 0`` is written in one of two exact forms (``psd_form``):
+design; ``kappa = sqrt(t_hi / t_lo)`` at the optimum).  A matrix
+inequality ``X >= 0`` (p x p) is written in one of two exact forms (``psd_form``):
 
-* ``"minors"``: all 15 principal minors >= 0 (used for ``E``);
+* ``"minors"``: all ``2^p - 1`` principal minors >= 0 (used for ``E`` when
+  p <= 4: the planar robot's 15);
 * ``"chol"``: ``X = L L^T`` with an auxiliary lower-triangular ``L``
-  (10 variables, ``diag(L) >= 0``, 10 polynomial equalities, linear in
-  ``X``; used for ``cond``, where the minors of ``M - t_lo I``, with
-  ``kappa^2 ~ 1e4``, are badly scaled and most starts hit the iteration limit).
+  (``p (p + 1) / 2`` variables, ``diag(L) >= 0``, as many polynomial
+  equalities, linear in ``X``; used for ``cond``, where the minors of
+  ``M - t_lo I``, with ``kappa^2 ~ 1e4``, are badly scaled and most starts hit
+  the iteration limit, and for ``E`` when p > 4: the Delta's 63 minors of
+  6 x 6 matrices are slow to build and to solve, see :func:`_psd_form`).
 
-(Only the four *leading* minors would not do: they admit spurious points
+(Only the p *leading* minors would not do: they admit spurious points
 where two minors vanish -- Ipopt stopped at ``t = lambda_2 > lambda_min``.)
 For these two criteria Ipopt starts with a small barrier parameter
 (``mu_init = 1e-6``) so that the auxiliary variables are not pushed away
@@ -37,20 +42,27 @@ from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, 
                                             _pointwise_ok, check_design, make_constraints)
 from zerocal_sym.design.criteria import (_check_criterion, _fisher_batch, _noise_terms, _objective_batch,
                                          _terms_batch, _user_value)
-from zerocal_sym.design.terms import _pose_terms_fn, _qscale, pose_terms
+from zerocal_sym.design.terms import _crlb_weights, _pose_terms_fn, _qscale, pose_terms
 
-#: formulation of the matrix inequalities per criterion (measured best, see module docstring)
+#: formulation of the matrix inequalities per criterion for p <= 4 (measured best, see module docstring)
 PSD_FORM = {"E": "minors", "cond": "chol"}
+
+
+def _psd_form(criterion, p):
+    """:data:`PSD_FORM` for p <= 4; ``chol`` beyond (the Delta, p = 6: the 63 minors of ``E`` took 2-3 times
+    the build time and 5-10 times the solve time of ``chol``, one of 4 starts hit the iteration limit)."""
+    return PSD_FORM.get(criterion, "chol") if p <= 4 else "chol"
 
 
 # --------------------------------------------------------------------------- continuous (Ipopt)
 def _minors(M):
-    """All principal minors of a symbolic 4 x 4 matrix (15): all >= 0 <=> PSD."""
+    """All principal minors of a symbolic p x p matrix (2^p - 1): all >= 0 <=> PSD."""
     import casadi as ca
 
+    p = M.shape[0]
     out = []
-    for r in range(1, 5):
-        for idx in itertools.combinations(range(4), r):
+    for r in range(1, p + 1):
+        for idx in itertools.combinations(range(p), r):
             idx = list(idx)
             out.append(ca.det(M[idx, idx]))
     return out
@@ -64,11 +76,15 @@ class _NLP:
         import casadi as ca
 
         self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
-        psd_form = psd_form or PSD_FORM.get(criterion, "chol")
         sm2, sx2 = _noise_terms(noise)
         qs = _qscale(robot)
-        c, h = cons.region.center, cons.region.half
-        z = ca.SX.sym("z", 2, K)
+        wc = _crlb_weights(robot)
+        dim, p = robot.n, len(qs)  # pose coordinates, parameters
+        psd_form = psd_form or _psd_form(criterion, p)
+        self.n = dim
+        region = cons.region
+        c, h = region.center, region.half
+        z = ca.SX.sym("z", dim, K)
         P = ca.repmat(ca.DM(c), 1, K) + ca.repmat(ca.DM(h), 1, K) * z
         f = _pose_terms_fn(robot.mechanism_name).map(K)
         theta, ratio, s, rho, a, dth = f(P, robot.geometry)
@@ -83,12 +99,14 @@ class _NLP:
             ubg.append(np.broadcast_to(hi, expr.shape[0]).astype(float))
 
         add(ratio, -1 + 1e-9, 1 - 1e-9)
+        if region.kind == "cylinder":  # x^2 + y^2 <= rw^2 (the box bounds give z and the bounding square)
+            add((P[0, :] ** 2 + P[1, :] ** 2) / region.rw ** 2, -np.inf, 1.0)
         if cons.singularity_margin > 0:
             add(s ** 2, (cons.singularity_margin + 1e-7) ** 2, np.inf)
         if cons.joint_limits_deg is not None:
             jl = np.radians(np.asarray(cons.joint_limits_deg))
-            add(theta[0, :], jl[0, 0] + 1e-9, jl[0, 1] - 1e-9)
-            add(theta[1, :], jl[1, 0] + 1e-9, jl[1, 1] - 1e-9)
+            for i in range(robot.m):
+                add(theta[i, :], jl[i, 0] + 1e-9, jl[i, 1] - 1e-9)
         aux = []  # (name, symbol column, lb, ub, init(nums) -> values)
         l0 = cons.travel_mm
         if cons.travel_mode == "range":
@@ -105,13 +123,13 @@ class _NLP:
             add(ca.vertcat(*d2), (cons.min_separation_mm + 1e-6) ** 2 / 1e4, np.inf)
 
         def psd(name, X, X0):
-            """X (symbolic 4 x 4) >= 0 as X = L L^T with L lower-triangular (auxiliary)."""
+            """X (symbolic p x p) >= 0: principal minors, or X = L L^T with L lower-triangular (auxiliary)."""
             if psd_form == "minors":
                 add(ca.vertcat(*_minors(X)), 0, np.inf)
                 return
-            tri = [(i, j) for i in range(4) for j in range(i + 1)]
+            tri = [(i, j) for i in range(p) for j in range(i + 1)]
             lv = ca.SX.sym(name, len(tri))
-            Lm = ca.SX.zeros(4, 4)
+            Lm = ca.SX.zeros(p, p)
             for k, (i, j) in enumerate(tri):
                 Lm[i, j] = lv[k]
             R = X - Lm @ Lm.T
@@ -120,7 +138,7 @@ class _NLP:
 
             def init(n):
                 Xn = X0(n)
-                Lc = np.linalg.cholesky(Xn + 1e-12 * max(np.trace(Xn), 1e-12) * np.eye(4))
+                Lc = np.linalg.cholesky(Xn + 1e-12 * max(np.trace(Xn), 1e-12) * np.eye(p))
                 return np.array([Lc[i, j] for i, j in tri])
 
             aux.append((name, lv, lb, np.inf, init))
@@ -128,13 +146,13 @@ class _NLP:
         # differences and Fisher information (LDL^T of the tridiagonal covariance)
         b = [aq[:, i + 1] - aq[:, i] for i in range(K - 1)]
         if criterion == "cond":
-            M = sum((bi @ bi.T for bi in b), ca.SX.zeros(4, 4)) / mscale
+            M = sum((bi @ bi.T for bi in b), ca.SX.zeros(p, p)) / mscale
             tl = ca.SX.sym("tlo")
             th_ = ca.SX.sym("thi")
             aux.append(("tlo", tl, 1e-12, np.inf, lambda n: max(0.5 * n["wM"][0], 1e-12)))
             aux.append(("thi", th_, 1e-12, np.inf, lambda n: 1.5 * n["wM"][-1]))
-            psd("Llo", M - tl * ca.SX.eye(4), lambda n: n["M"] - 0.5 * n["wM"][0] * np.eye(4))
-            psd("Lhi", th_ * ca.SX.eye(4) - M, lambda n: 1.5 * n["wM"][-1] * np.eye(4) - n["M"])
+            psd("Llo", M - tl * ca.SX.eye(p), lambda n: n["M"] - 0.5 * n["wM"][0] * np.eye(p))
+            psd("Lhi", th_ * ca.SX.eye(p) - M, lambda n: 1.5 * n["wM"][-1] * np.eye(p) - n["M"])
             obj = 0.5 * (ca.log(th_) - ca.log(tl))
         else:
             d = [sm2 + v[i] + v[i + 1] for i in range(K - 1)]
@@ -152,18 +170,18 @@ class _NLP:
             elif criterion == "E":
                 tt = ca.SX.sym("t")
                 aux.append(("t", tt, 1e-12, np.inf, lambda n: max(0.5 * n["wF"][0], 1e-12)))
-                psd("L", Fn - tt * ca.SX.eye(4), lambda n: n["Fn"] - 0.5 * n["wF"][0] * np.eye(4))
+                psd("L", Fn - tt * ca.SX.eye(p), lambda n: n["Fn"] - 0.5 * n["wF"][0] * np.eye(p))
                 obj = -ca.log(tt)
             else:
                 Finv = ca.inv(Fn)
                 if criterion == "A":
                     obj = ca.log(ca.trace(Finv))
                 else:
-                    obj = ca.log(Finv[0, 0] * qs[0] ** 2 + Finv[1, 1] * qs[1] ** 2)
+                    obj = ca.log(sum(float(wc[j]) * Finv[j, j] for j in range(p) if wc[j] != 0))
         self.aux = aux
         x = ca.vertcat(ca.vec(z), *[a_[1] for a_ in aux])
-        self.lbx = np.concatenate([-np.ones(2 * K)] + [np.broadcast_to(a_[2], a_[1].shape[0]) for a_ in aux])
-        self.ubx = np.concatenate([np.ones(2 * K)] + [np.broadcast_to(a_[3], a_[1].shape[0]) for a_ in aux])
+        self.lbx = np.concatenate([-np.ones(dim * K)] + [np.broadcast_to(a_[2], a_[1].shape[0]) for a_ in aux])
+        self.ubx = np.concatenate([np.ones(dim * K)] + [np.broadcast_to(a_[3], a_[1].shape[0]) for a_ in aux])
         self.lbg = np.concatenate(lbg)
         self.ubg = np.concatenate(ubg)
         self.fscale, self.mscale = fscale, mscale
@@ -176,7 +194,7 @@ class _NLP:
         self.solver = ca.nlpsol("design", "ipopt", {"x": x, "f": obj, "g": ca.vertcat(*g)}, opts)
         #: objective and constraints as a Function of x (for checks)
         self.fg = ca.Function("design_fg", [x], [obj, ca.vertcat(*g)])
-        self.sm2, self.sx2, self.qs = sm2, sx2, qs
+        self.sm2, self.sx2, self.qs, self.wc = sm2, sx2, qs, wc
 
     def x0(self, P0):
         """Initial point from a design (auxiliary variables from its numeric values)."""
@@ -191,14 +209,14 @@ class _NLP:
         nums["wM"] = np.linalg.eigvalsh(nums["M"])
         nums["wF"] = np.linalg.eigvalsh(nums["Fn"])
         aux = [np.atleast_1d(a_[4](nums)) for a_ in self.aux]
-        return np.concatenate([z0.ravel()] + aux)  # z is (2, K) column-major == P0 row-major
+        return np.concatenate([z0.ravel()] + aux)  # z is (n, K) column-major == P0 (K, n) row-major
 
     def solve(self, P0):
-        """Run Ipopt from ``P0`` (K, 2); returns (P, status, iterations)."""
+        """Run Ipopt from ``P0`` (K, n); returns (P, status, iterations), P of shape (K, n)."""
         sol = self.solver(x0=self.x0(P0), lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         st = self.solver.stats()
         x = sol["x"].full().ravel()
-        z = np.clip(x[:2 * self.K].reshape(self.K, 2), -1, 1)
+        z = np.clip(x[:self.n * self.K].reshape(self.K, self.n), -1, 1)
         P = self.cons.region.center + self.cons.region.half * z
         return P, st.get("return_status", "?"), int(st.get("iter_count", -1))
 
@@ -206,7 +224,7 @@ class _NLP:
 def _random_start(robot, K, cons, rng, tries=50):
     """A random design of K feasible, separated poses (None if none found)."""
     for _ in range(tries):
-        pts = cons.region.lo + rng.uniform(size=(40 * K, 2)) * (cons.region.hi - cons.region.lo)
+        pts = cons.region.sample(rng, 40 * K)
         pts = pts[_pointwise_ok(robot, pts, cons)]
         if len(pts) < K:
             continue
@@ -232,7 +250,8 @@ def _scales(robot, P, noise):
     v = sx2 * np.sum(t["dth"] ** 2, axis=1)
     F = _fisher_batch(aq[None], v[None], sm2)[0]
     G = np.diff(aq, axis=0)
-    return max(np.trace(F) / 4, 1e-300), max(np.trace(G.T @ G) / 4, 1e-300)
+    p = aq.shape[1]
+    return max(np.trace(F) / p, 1e-300), max(np.trace(G.T @ G) / p, 1e-300)
 
 
 def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
@@ -251,19 +270,19 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         Seed of the random starts.
     n_starts : int
         Number of random starts.
-    starts : list of (label, ndarray shape (K, 2)), optional
-        Extra starts (e.g. the paper's scheme, an exchange design).
+    starts : list of (label, ndarray shape (K, n)), optional
+        Extra starts (e.g. the boundary scheme, an exchange design).
 
     Returns
     -------
     dict
-        ``poses`` (K, 2) of the best feasible local optimum, ``objective``,
+        ``poses`` (K, n) of the best feasible local optimum, ``objective``,
         ``value`` (user units), ``runs`` (label, value, status, iterations,
         feasible, time per start), ``time_s``, ``build_s``.
     """
     t0 = time.perf_counter()
     cons = cons or make_constraints(robot)
-    _check_k(K)
+    _check_k(K, robot)
     _check_criterion(criterion)
     rng = np.random.default_rng(seed)
     all_starts = list(starts or [])
@@ -274,18 +293,18 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
     if not all_starts:
         raise DesignError("could not find a feasible random start: the constraints leave (almost) no room")
     ref = next((P for _, P in all_starts if np.isfinite(_objective_batch(
-        "D", *_terms_batch(robot, P, noise), _noise_terms(noise)[0], _qscale(robot))[0])), all_starts[0][1])
+        "D", *_terms_batch(robot, P, noise), _noise_terms(noise)[0], _crlb_weights(robot))[0])), all_starts[0][1])
     fscale, mscale = _scales(robot, ref, noise)
     nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter)
     build_s = time.perf_counter() - t0
     best, runs = None, []
     sm2 = _noise_terms(noise)[0]
-    qs = _qscale(robot)
+    wc = _crlb_weights(robot)
     for label, P0 in all_starts:
         ts = time.perf_counter()
         P, status, iters = nlp.solve(P0)
         viol = check_design(robot, P, cons)
-        o = float(_objective_batch(criterion, *_terms_batch(robot, P, noise), sm2, qs)[0])
+        o = float(_objective_batch(criterion, *_terms_batch(robot, P, noise), sm2, wc)[0])
         runs.append({"start": label, "value": _user_value(criterion, o), "status": status, "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
         if not viol and np.isfinite(o) and (best is None or o < best[1]):

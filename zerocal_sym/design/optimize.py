@@ -5,11 +5,11 @@ offsets as accurate as possible, within what the robot and the measuring
 mechanism allow.  Two methods, each a check on the other:
 
 * **continuous** (:func:`continuous_design`): the K poses (scaled to
-  ``[-1, 1]^2`` over the design region) are the decision variables of a
+  ``[-1, 1]^n`` over the design region) are the decision variables of a
   CasADi/Ipopt NLP built symbolically from the generated mechanism functions
   (inverse kinematics, transmission sines, exact distance and its AD
   derivatives); multi-start from seeded random feasible designs and from the
-  paper's scheme;
+  boundary scheme;
 * **discrete exchange** (:func:`exchange_design`): coordinate exchange
   (Fedorov / DETMAX family) over a candidate grid of feasible poses, every
   slot of the ordered design swapped against every candidate until no swap
@@ -17,8 +17,13 @@ mechanism allow.  Two methods, each a check on the other:
 
 :func:`optimize_design` runs both, improves the visiting order of the best
 design (exhaustively for K <= 8, by pair swaps and segment reversals
-otherwise), polishes it with Ipopt and returns it with the paper's scheme at
-the same K as the baseline.
+otherwise), polishes it with Ipopt and returns it with the workspace's
+boundary scheme at the same K as the baseline: the paper's scheme on a
+rectangle, the ring scheme (``DELTA.md``) on a cylinder.  (The
+result keeps the name ``paper`` for the baseline's report.)
+
+Everything is generic over the mechanism: poses (K, n), joints (K, m), the
+p = m + n parameters of the paper's Eq. (28).
 
 The model and the criteria are in :mod:`zerocal_sym.design.criteria`, the
 constraints in :mod:`zerocal_sym.design.constraints`, the Ipopt NLP in
@@ -34,8 +39,8 @@ import numpy as np
 
 from zerocal_sym.io.files import json_safe
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.design.constraints import (Constraints, DesignError, Region, _check_k, check_design,
-                                            make_constraints)
+from zerocal_sym.design.constraints import (Constraints, CylinderRegion, DesignError, Region, _check_k,
+                                            check_design, make_constraints, workspace_region)
 from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective, evaluate
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
@@ -43,29 +48,33 @@ from zerocal_sym.design.order import best_order
 
 
 # --------------------------------------------------------------------------- baseline
-def paper_baseline(robot, K: int, region: Region | None = None) -> np.ndarray:
-    """The paper's scheme with K poses, as the baseline.
+def paper_baseline(robot, K: int, region: Region | CylinderRegion | None = None) -> np.ndarray:
+    """The workspace's boundary scheme with K poses, as the baseline.
 
-    Even K: :func:`zerocal_sym.paper.scheme.paper_poses` with ``n = K/2`` (on the
-    region's lower and upper edges when a region is given).  Odd K (the paper
-    has none): ``ceil(K/2)`` evenly spaced poses on ``y = ymin`` then
-    ``floor(K/2)`` on ``y = ymax``, each from ``xmin`` to ``xmax``.
+    Even K on the whole workspace: ``robot.workspace.boundary_scheme(K // 2)``
+    -- the paper's scheme on a rectangle (``n = K/2`` poses on ``y = H`` then
+    on ``y = H + h``), the ring scheme on a cylinder (``n`` poses on the top
+    circle at azimuths ``360 deg j/n``, then on the bottom one).  On a smaller
+    region or for odd K (the paper has none) the same rule on the region's
+    boundaries with ``ceil(K/2)`` poses on the first (``y = ymin``; the top
+    circle) and ``floor(K/2)`` on the second (``y = ymax``; the bottom
+    circle): :meth:`Region.boundary_scheme`, :meth:`CylinderRegion.boundary_scheme`.
 
     Returns
     -------
-    ndarray, shape (K, 2)
+    ndarray, shape (K, n)
         mm, in visiting order.
     """
-    from zerocal_sym.paper.scheme import paper_poses
-
-    ws = Region.workspace(robot)
+    ws = workspace_region(robot)
     region = region or ws
     if K % 2 == 0 and region == ws:
-        return paper_poses(robot, K // 2)
+        return robot.workspace.boundary_scheme(K // 2)
     n1 = (K + 1) // 2
-    n2 = K - n1
-    return np.vstack([np.column_stack([np.linspace(region.xmin, region.xmax, n1), np.full(n1, region.ymin)]),
-                      np.column_stack([np.linspace(region.xmin, region.xmax, n2), np.full(n2, region.ymax)])])
+    return region.boundary_scheme(n1, K - n1)
+
+
+#: the same function under its generic name
+boundary_baseline = paper_baseline
 
 
 # --------------------------------------------------------------------------- driver
@@ -75,13 +84,15 @@ class DesignResult:
 
     Attributes
     ----------
-    poses : ndarray, shape (K, 2)
+    poses : ndarray, shape (K, n)
         mm, in visiting order.
     criterion : str
     report : dict
         :func:`evaluate` of the design.
     paper : dict
-        :func:`evaluate` of the paper's scheme with the same K.
+        :func:`evaluate` of the baseline: the workspace's boundary scheme
+        with the same K (:func:`paper_baseline`; the paper's scheme on a
+        rectangle, the ring scheme on a cylinder).
     constraints : Constraints
     exchange : dict
         The discrete exchange's best (poses, value, starts, time).
@@ -91,6 +102,9 @@ class DesignResult:
         Which method gave the final design.
     timing : dict
         Seconds per stage.
+    noise : NoiseModel
+    baseline : str
+        Name of the baseline scheme (``paper`` | ``ring``).
     """
 
     poses: np.ndarray
@@ -103,6 +117,7 @@ class DesignResult:
     method: str
     timing: dict = field(default_factory=dict)
     noise: NoiseModel | None = None
+    baseline: str = "paper"
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
@@ -113,6 +128,7 @@ class DesignResult:
         rep.update({
             "K": len(self.poses),
             "method": self.method,
+            "baseline": self.baseline,
             "paper": self.paper,
             "ratio": {
                 "crlb_rms_design_over_paper": _ratio(self.report["crlb_rms_deg"], self.paper["crlb_rms_deg"]),
@@ -141,11 +157,11 @@ def _ratio(a, b):
 
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
-                    exchange_starts: int = 8, grid=(25, 11), reorder: bool = True) -> DesignResult:
-    """Optimal measurement poses for a criterion, with the paper's scheme as baseline.
+                    exchange_starts: int = 8, grid=None, reorder: bool = True) -> DesignResult:
+    """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
     Stages: discrete exchange (``exchange_starts`` seeded starts over the
-    candidate grid); Ipopt multi-start from the paper's scheme (if feasible)
+    candidate grid); Ipopt multi-start from the boundary scheme (if feasible)
     and ``n_starts`` seeded random feasible designs; the better of the two,
     re-ordered (:func:`best_order`) and, if re-ordered, polished by Ipopt
     from the exchange design as well; the best feasible design wins.
@@ -154,7 +170,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     ----------
     robot : Robot
     K : int
-        Number of poses (>= 5).
+        Number of poses (>= p + 1: 5 for the planar robot, 7 for the Delta).
     criterion : {"cond", "D", "A", "E", "crlb"}
     cons : Constraints, optional
         Default :func:`make_constraints` (workspace, l0 = 350 mm range,
@@ -163,14 +179,15 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         Default the paper's.
     seed : int
     n_starts, exchange_starts : int
-    grid : (int, int)
-        Candidate grid of the exchange.
+    grid : tuple of int, optional
+        Candidate grid of the exchange (default the region's, see
+        :func:`zerocal_sym.design.exchange.candidate_grid`).
 
     Returns
     -------
     DesignResult
     """
-    _check_k(K)
+    _check_k(K, robot)
     _check_criterion(criterion)
     noise = noise or NoiseModel.paper()
     _noise_terms(noise)
@@ -180,7 +197,8 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid)
     timing["exchange"] = time.perf_counter() - t0
     base = paper_baseline(robot, K, cons.region)
-    starts = [("paper scheme", base)] if not check_design(robot, base, cons) else []
+    scheme = robot.workspace.scheme_name
+    starts = [(f"{scheme} scheme", base)] if not check_design(robot, base, cons) else []
     t1 = time.perf_counter()
     cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts)
     timing["continuous"] = time.perf_counter() - t1
@@ -208,4 +226,4 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     timing["total"] = time.perf_counter() - t0
     return DesignResult(poses=P, criterion=criterion, report=evaluate(robot, P, criterion, noise, cons),
                         paper=evaluate(robot, base, criterion, noise, cons), constraints=cons, exchange=ex,
-                        continuous=cont, method=label, timing=timing, noise=noise)
+                        continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme)

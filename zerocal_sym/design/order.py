@@ -14,7 +14,7 @@ import numpy as np
 
 from zerocal_sym.design.constraints import Constraints
 from zerocal_sym.design.criteria import _noise_terms, _objective_batch
-from zerocal_sym.design.terms import _qscale, pose_terms
+from zerocal_sym.design.terms import _crlb_weights, _qscale, pose_terms
 
 
 # --------------------------------------------------------------------------- ordering
@@ -42,12 +42,13 @@ def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None,
     K = len(P)
     sm2, sx2 = _noise_terms(noise)
     qs = _qscale(robot)
+    wc = _crlb_weights(robot)
     t = pose_terms(robot, P)
     rho = t["rho"]
 
     def objective(perms):
         aq, v = _permute_terms(t, perms, qs, sx2)
-        o = _objective_batch(criterion, aq, v, sm2, qs)
+        o = _objective_batch(criterion, aq, v, sm2, wc)
         if cons is not None and cons.travel_mode == "consecutive":
             o[np.max(np.abs(np.diff(rho[perms], axis=1)), axis=1) > cons.travel_mm] = np.inf
         return o

@@ -1,20 +1,127 @@
-"""Figure of a design and the paper's scheme in the workspace (:func:`plot_design`)."""
+"""Figure of a design and the boundary scheme in the workspace (:func:`plot_design`).
+
+n = 2 (rectangle): the plane, with the area excluded by the singularity
+margin.  n = 3 (cylinder): a top view (x-y, the workspace circle) and a side
+view (radius ``sqrt(x^2 + y^2)`` against z, the workspace's section).
+"""
 from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym.design.constraints import Region
+from zerocal_sym.design.constraints import Region, workspace_region
 from zerocal_sym.design.optimize import DesignResult
 from zerocal_sym.design.terms import _call_ik, pose_terms
 
 
+def _labels(result):
+    d = result.to_dict()
+    ratio = d["ratio"]["crlb_rms_design_over_paper"]
+    base = f"{result.baseline}'s scheme" if result.baseline == "paper" else f"{result.baseline} scheme"
+    return (base, f"{base} (CRLB {result.paper['crlb_rms_deg']:.3f} deg)",
+            f"{result.criterion}-optimal (CRLB {result.report['crlb_rms_deg']:.3f} deg)",
+            f"K = {len(result.poses)}, criterion {result.criterion}; CRLB ratio design/{result.baseline} "
+            f"{'-' if ratio is None else format(ratio, '.3f')}")
+
+
+def _numbered(ax, X, Y, color="tab:blue"):
+    for k, (x, y) in enumerate(zip(X, Y)):
+        ax.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(4, 4 + 8 * (k % 2)), fontsize=8,
+                    color=color)
+
+
+def _plot_2d(fig, plt, robot, result):
+    cons = result.constraints
+    ws = workspace_region(robot)
+    reg = cons.region
+    _, base_label, design_label, title = _labels(result)
+    ax = fig.add_subplot(1, 1, 1)
+    lo = np.minimum(ws.lo, reg.lo) - 20
+    hi = np.maximum(ws.hi, reg.hi) + 20
+    box = Region(lo[0], hi[0], lo[1], hi[1])
+    grid = box.grid(97, 49)
+    th, ratio = _call_ik(robot, grid)
+    smin = np.full(len(grid), np.nan)
+    okr = np.all(np.abs(ratio) < 1, axis=1)
+    if np.any(okr):
+        smin[okr] = np.min(np.abs(pose_terms(robot, grid[okr])["s"]), axis=1)
+    Z = smin.reshape(49, 97)
+    X, Y = grid[:, 0].reshape(49, 97), grid[:, 1].reshape(49, 97)
+    if np.nanmin(Z) < cons.singularity_margin:
+        ax.contourf(X, Y, Z, levels=[0, cons.singularity_margin], colors=["#f4c7c3"])
+        ax.contour(X, Y, Z, levels=[cons.singularity_margin], colors=["#c0392b"], linewidths=0.8)
+    ax.add_patch(plt.Rectangle(ws.lo, *(ws.hi - ws.lo), fill=False, ec="k", lw=1.2, label="workspace"))
+    if reg != ws:
+        ax.add_patch(plt.Rectangle(reg.lo, *(reg.hi - reg.lo), fill=False, ec="tab:green", ls="--", lw=1.2,
+                                   label="design region"))
+    Pp = np.asarray(result.paper["poses"])
+    ax.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10, label=base_label)
+    P = result.poses
+    ax.plot(P[:, 0], P[:, 1], "-", color="tab:blue", lw=0.6, alpha=0.6)
+    ax.plot(P[:, 0], P[:, 1], "o", color="tab:blue", label=design_label)
+    _numbered(ax, P[:, 0], P[:, 1])
+    ax.set_aspect("equal")
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2)
+
+
+def _plot_3d(fig, plt, robot, result):
+    cons = result.constraints
+    ws = workspace_region(robot)
+    reg = cons.region
+    _, base_label, design_label, title = _labels(result)
+    top, side = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
+    P, Pp = result.poses, np.asarray(result.paper["poses"])
+    t = np.linspace(0, 2 * np.pi, 241)
+    # top view
+    top.plot(ws.rw * np.cos(t), ws.rw * np.sin(t), "k-", lw=1.2, label="workspace")
+    if reg != ws:
+        top.plot(reg.rw * np.cos(t), reg.rw * np.sin(t), "--", color="tab:green", lw=1.2, label="design region")
+    top.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10, label=base_label)
+    top.plot(P[:, 0], P[:, 1], "-", color="tab:blue", lw=0.6, alpha=0.6)
+    top.plot(P[:, 0], P[:, 1], "o", color="tab:blue", label=design_label)
+    _numbered(top, P[:, 0], P[:, 1])
+    lim = max(ws.rw, reg.rw) + 20
+    top.set_xlim(-lim, lim)
+    top.set_ylim(-lim, lim)
+    top.set_aspect("equal")
+    top.set_xlabel("x [mm]")
+    top.set_ylabel("y [mm]")
+    top.set_title("top view", fontsize=9)
+    # side view: radius against z
+    side.add_patch(plt.Rectangle((0, ws.zmin), ws.rw, ws.zmax - ws.zmin, fill=False, ec="k", lw=1.2))
+    if reg != ws:
+        side.add_patch(plt.Rectangle((0, reg.zmin), reg.rw, reg.zmax - reg.zmin, fill=False, ec="tab:green",
+                                     ls="--", lw=1.2))
+    rp, r = np.hypot(Pp[:, 0], Pp[:, 1]), np.hypot(P[:, 0], P[:, 1])
+    side.plot(rp, Pp[:, 2], "s", mfc="none", mec="tab:gray", ms=10)
+    side.plot(r, P[:, 2], "o", color="tab:blue")
+    _numbered(side, r, P[:, 2])
+    zlo, zhi = min(ws.zmin, reg.zmin) - 20, max(ws.zmax, reg.zmax) + 20
+    side.set_xlim(-10, lim)
+    side.set_ylim(zlo, zhi)
+    side.set_aspect("equal")
+    side.set_xlabel("r = sqrt(x^2 + y^2) [mm]")
+    side.set_ylabel("z [mm]")
+    side.set_title("side view", fontsize=9)
+    fig.suptitle(title, fontsize=10)
+    handles, labels = top.get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=2)
+
+
 # --------------------------------------------------------------------------- plot
 def plot_design(path, robot, result: DesignResult) -> None:
-    """PNG of the design and the paper's scheme in the workspace (atomic write).
+    """PNG of the design and the boundary scheme in the workspace (atomic write).
 
-    Shows the workspace and design region, the area excluded by the
-    singularity margin (if any), the design poses numbered in visiting order
-    with the path between them, and the paper's scheme with the same K.
+    Shows the workspace and design region, the design poses numbered in
+    visiting order with the path between them, and the baseline (the
+    paper's scheme on a rectangle, the ring scheme on a cylinder) with the
+    same K.  n = 2: one plane, with the area excluded by the singularity
+    margin (if any).  n = 3: a top view (x-y) and a side view (radius
+    against z).
     """
     import io
 
@@ -25,49 +132,16 @@ def plot_design(path, robot, result: DesignResult) -> None:
 
     from zerocal_sym.io.files import atomic_write_bytes
 
-    cons = result.constraints
-    ws = Region.workspace(robot)
-    reg = cons.region
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    if robot.n not in (2, 3):
+        raise ValueError(f"plot_design draws 2-D and 3-D workspaces, not n = {robot.n}")
+    fig = plt.figure(figsize=(7.5, 4.8) if robot.n == 2 else (10.0, 5.4))
     try:
-        lo = np.minimum(ws.lo, reg.lo) - 20
-        hi = np.maximum(ws.hi, reg.hi) + 20
-        box = Region(lo[0], hi[0], lo[1], hi[1])
-        grid = box.grid(97, 49)
-        th, ratio = _call_ik(robot, grid)
-        smin = np.full(len(grid), np.nan)
-        okr = np.all(np.abs(ratio) < 1, axis=1)
-        if np.any(okr):
-            smin[okr] = np.min(np.abs(pose_terms(robot, grid[okr])["s"]), axis=1)
-        Z = smin.reshape(49, 97)
-        X, Y = grid[:, 0].reshape(49, 97), grid[:, 1].reshape(49, 97)
-        if np.nanmin(Z) < cons.singularity_margin:
-            ax.contourf(X, Y, Z, levels=[0, cons.singularity_margin], colors=["#f4c7c3"])
-            ax.contour(X, Y, Z, levels=[cons.singularity_margin], colors=["#c0392b"], linewidths=0.8)
-        ax.add_patch(plt.Rectangle(ws.lo, *(ws.hi - ws.lo), fill=False, ec="k", lw=1.2, label="workspace"))
-        if reg != ws:
-            ax.add_patch(plt.Rectangle(reg.lo, *(reg.hi - reg.lo), fill=False, ec="tab:green", ls="--", lw=1.2,
-                                       label="design region"))
-        Pp = np.asarray(result.paper["poses"])
-        ax.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10,
-                label=f"paper's scheme (CRLB {result.paper['crlb_rms_deg']:.3f} deg)")
-        P = result.poses
-        ax.plot(P[:, 0], P[:, 1], "-", color="tab:blue", lw=0.6, alpha=0.6)
-        ax.plot(P[:, 0], P[:, 1], "o", color="tab:blue",
-                label=f"{result.criterion}-optimal (CRLB {result.report['crlb_rms_deg']:.3f} deg)")
-        for k, p in enumerate(P):
-            ax.annotate(str(k + 1), p, textcoords="offset points", xytext=(4, 4 + 8 * (k % 2)), fontsize=8,
-                        color="tab:blue")
-        ax.set_aspect("equal")
-        ax.set_xlim(lo[0], hi[0])
-        ax.set_ylim(lo[1], hi[1])
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("y [mm]")
-        ratio = result.to_dict()["ratio"]["crlb_rms_design_over_paper"]
-        ax.set_title(f"K = {len(P)}, criterion {result.criterion}; CRLB ratio design/paper "
-                     f"{'-' if ratio is None else format(ratio, '.3f')}", fontsize=10)
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2)
-        fig.tight_layout()
+        if robot.n == 2:
+            _plot_2d(fig, plt, robot, result)
+            fig.tight_layout()
+        else:
+            _plot_3d(fig, plt, robot, result)
+            fig.tight_layout(rect=(0, 0.1, 1, 0.95))
         buf = io.BytesIO()
         fig.savefig(buf, format="png", dpi=120)
     finally:

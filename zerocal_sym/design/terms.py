@@ -1,9 +1,13 @@
-"""Per-pose terms of the design model.
+"""Per-pose terms of the design model, for every mechanism.
 
-For each pose: the inverse-kinematics joints, the transmission sines, the
-distance ``rho`` and its exact derivatives (CasADi AD of the generated
-mechanism functions, at zero source errors), and the q-unit scaling of the
-sensitivities (see :mod:`zerocal_sym.design.criteria`).
+For each pose: the inverse-kinematics joints, the singularity indicators
+(transmission sines), the distance ``rho`` and its exact derivatives (CasADi
+AD of the generated mechanism functions, at zero source errors), and the
+q-unit scaling of the sensitivities (see :mod:`zerocal_sym.design.criteria`).
+
+The design parameters are the paper's set ``robot.errors.resolve("paper")``:
+the m zero offsets then the n MAEMM components (p = m + n), in the
+mechanism's source-error order.
 """
 from __future__ import annotations
 
@@ -11,35 +15,52 @@ from functools import lru_cache
 
 import numpy as np
 
-#: paper parameter indices in the source-error vector
-_PAPER = (0, 1, 10, 11)
-
 
 def _call_ik(robot, P):
+    """Inverse kinematics and reach ratios without checks, shapes (K, m) each."""
     f = robot.mechanism["ik"]
-    theta, ratio = f(np.asarray(P, float).T, robot.geometry)
-    return theta.full().T, ratio.full().T
+    P = np.atleast_2d(np.asarray(P, float))
+    theta, ratio = f(P.T, robot.geometry)
+    return theta.full().T.reshape(len(P), -1), ratio.full().T.reshape(len(P), -1)
+
+
+def _reachable(ratio, theta, tol: float = 0.0) -> np.ndarray:
+    """Bool per pose: every limb closes (|ratio| <= 1 - tol) and the joints are finite, shape (K,)."""
+    return np.all(np.abs(ratio) <= 1.0 - tol, axis=1) & np.all(np.isfinite(theta), axis=1)
+
+
+def design_params(robot) -> tuple:
+    """Names of the design parameters: the zero offsets and the MAEMM (the paper's set), p = m + n."""
+    return robot.errors.resolve("paper")
+
+
+def offset_positions(robot) -> list:
+    """Positions of the zero offsets among :func:`design_params`, shape (m,)."""
+    names = design_params(robot)
+    return [names.index(z) for z in robot.errors.zero_offsets]
 
 
 # --------------------------------------------------------------------------- per-pose terms
 @lru_cache(maxsize=None)
 def _pose_terms_fn(mech_name: str):
-    """CasADi Function (P[2], g[12]) -> theta[2], ratio[2], s[3], rho, a[4], dth[2].
+    """CasADi Function (P[n], g[G]) -> theta[m], ratio[m], s[s], rho, a[p], dth[m].
 
-    ``a = d rho / d (dth1, dth2, drMx, drMy)`` (per rad, per mm) and
-    ``dth = d rho / d theta`` (per rad), exact derivatives at zero source
-    errors, joints from the inverse kinematics.
+    ``a = d rho / d (zero offsets, MAEMM)`` (per rad, per mm; the paper's
+    parameter set, p = m + n) and ``dth = d rho / d theta`` (per rad), exact
+    derivatives at zero source errors, joints from the inverse kinematics.
     """
     import casadi as ca
 
     from zerocal_sym.model.mechanism import get_mechanism
 
     mech = get_mechanism(mech_name)
-    P = ca.SX.sym("P", 2)
+    n, m = mech.n, mech.m
+    idx = mech.errors.indices("paper")
+    P = ca.SX.sym("P", n)
     g = ca.SX.sym("g", mech["ik"].size1_in(1))
     theta, ratio = mech["ik"](P, g)
     s = mech["transmission"](P, theta, g)
-    th = ca.SX.sym("th", 2)
+    th = ca.SX.sym("th", m)
     ne = mech["distance"].size1_in(2)
     err = ca.SX.sym("err", ne)
     rho = mech["distance"](th, g, err)
@@ -47,7 +68,7 @@ def _pose_terms_fn(mech_name: str):
     dt = ca.jacobian(rho, th)
     sub = ca.Function("drho", [th, g, err], [rho, de, dt])
     r, de_v, dt_v = sub(theta, g, ca.DM.zeros(ne))
-    a = ca.vertcat(*[de_v[0, i] for i in _PAPER])
+    a = ca.vertcat(*[de_v[0, i] for i in idx])
     return ca.Function("design_pose_terms", [P, g], [theta, ratio, s, r, a, dt_v.T],
                        ["P", "g"], ["theta", "ratio", "s", "rho", "a", "dth"])
 
@@ -57,26 +78,43 @@ def pose_terms(robot, P) -> dict:
 
     Parameters
     ----------
-    P : ndarray, shape (K, 2)
+    P : ndarray, shape (K, n)
         Poses, mm.
 
     Returns
     -------
     dict
-        ``theta`` (K, 2) rad, ``ratio`` (K, 2), ``s`` (K, 3) transmission
-        sines, ``rho`` (K,) mm, ``a`` (K, 4) d rho / d p (per rad, per mm),
-        ``dth`` (K, 2) d rho / d theta (mm/rad).
+        ``theta`` (K, m) rad, ``ratio`` (K, m), ``s`` (K, s) singularity
+        indicators, ``rho`` (K,) mm, ``a`` (K, p) d rho / d p (per rad, per
+        mm; p = m + n, :func:`design_params`), ``dth`` (K, m) d rho / d theta
+        (mm/rad).
     """
     P = np.atleast_2d(np.asarray(P, float))
+    K = len(P)
     f = _pose_terms_fn(robot.mechanism_name)
     out = f(P.T, robot.geometry)
     names = ("theta", "ratio", "s", "rho", "a", "dth")
-    res = {n: o.full().T for n, o in zip(names, out)}
+    res = {nm: o.full().T.reshape(K, -1) for nm, o in zip(names, out)}
     res["rho"] = res["rho"][:, 0]
     return res
 
 
 def _qscale(robot):
-    """``1 / fisher.parameter_scale``: q-unit sensitivities are ``a * qs``, shape (4,)."""
-    L1, L2 = robot.link_lengths
-    return np.array([1.0 / L1, 1.0 / L2, 1.0, 1.0])
+    """``1 / fisher.parameter_scale``: q-unit sensitivities are ``a * qs``, shape (p,).
+
+    An angle's q-unit is its arc on the lever arm (``L_i dtheta_i``, mm), a
+    length is its own (mm): ``qs = 1 / robot.error_scale(names)``.
+    """
+    return 1.0 / robot.error_scale(design_params(robot))
+
+
+def _crlb_weights(robot):
+    """Weights ``w`` of the crlb criterion: ``mean_i var(dtheta_i) = sum_j w_j [F_q^-1]_jj``, shape (p,).
+
+    ``w_j = qs_j^2 / m`` on the zero offsets (q-units back to rad), 0 on the MAEMM.
+    """
+    qs = _qscale(robot)
+    w = np.zeros_like(qs)
+    off = offset_positions(robot)
+    w[off] = qs[off] ** 2 / len(off)
+    return w
