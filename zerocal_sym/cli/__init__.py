@@ -28,7 +28,8 @@ def _command_modules():
 def build_parser() -> argparse.ArgumentParser:
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--robot", metavar="FILE", default=None,
-                        help="robot TOML file (default: the paper's robot, Table 1)")
+                        help="robot TOML file, any mechanism (default: the paper's robot, Table 1; "
+                             "examples/delta.toml: the rotary Delta)")
     parser = argparse.ArgumentParser(
         prog="zerocal",
         description="Zero-offset calibration of parallel robots (Mei et al. 2017, and beyond).")

@@ -11,7 +11,8 @@ True errors (exactly one of):
 
 * ``--set NAME=VALUE`` (repeatable): source errors by name, in the robot's
   frame, degrees for angles and mm otherwise, the others zero; the names are
-  the robot mechanism's (``zerocal simulate --set help=0`` lists them), e.g.
+  the robot mechanism's source errors (an unknown name is an error that
+  lists them), e.g.
   ``--set theta1=2 --set theta2=-1 --set theta3=0.5 --set rMz=0.3``;
 * ``--group G``: Table 2's group G of the paper (its planar robot only),
   read in the paper's frame, i.e. ours mirrored about the x axis, unless
