@@ -51,31 +51,58 @@ IPOPT_OPTIONS = {
     "print_time": False,
 }
 
+#: up to this K the functions are SX, expanded (fastest to evaluate); above, MX graphs with the per-pose
+#: model mapped over K (build time and memory linear in K, no K-fold inlining)
+EXPAND_MAX_K = 120
+
 _CACHE: dict = {}
 _LOCK = threading.Lock()
 
 
 def _banded_whiten(r, l, b):
-    """``L^-1 r`` for the lower-bidiagonal ``L`` (diagonal ``l``, sub-diagonal ``b``): forward substitution."""
+    """``L^-1 r`` for the lower-bidiagonal ``L`` (diagonal ``l``, sub-diagonal ``b``): forward substitution.
+
+    SX: written out (inlined); MX: one ``mapaccum`` node over the K-1 changes.
+    """
     import casadi as ca
 
-    out = [r[0] / l[0]]
-    for k in range(1, r.shape[0]):
-        out.append((r[k] - b[k - 1] * out[-1]) / l[k])
-    return ca.vertcat(*out)
+    if isinstance(r, ca.SX):
+        out = [r[0] / l[0]]
+        for k in range(1, r.shape[0]):
+            out.append((r[k] - b[k - 1] * out[-1]) / l[k])
+        return ca.vertcat(*out)
+    y, rk, bk, lk = (ca.SX.sym(n) for n in ("y", "r", "b", "l"))
+    step = ca.Function("whiten_step", [y, rk, bk, lk], [(rk - bk * y) / lk])
+    n = r.shape[0]
+    acc = step.mapaccum("whiten", n)
+    return acc(0, r.T, ca.horzcat(0, b.T), l.T).T
 
 
 def _banded_cholesky(v, sm2):
-    """Diagonal and sub-diagonal of chol(sm2 I + D diag(v) D^T), D the (K-1) x K first differences."""
+    """Diagonal and sub-diagonal of chol(sm2 I + D diag(v) D^T), D the (K-1) x K first differences.
+
+    SX: written out; MX: one ``mapaccum`` node for the recurrence
+    ``b_k = -v_k / l_{k-1}``, ``l_k = sqrt(c_k - b_k^2)``.
+    """
     import casadi as ca
 
     n = v.shape[0] - 1
-    c = [sm2 + v[k] + v[k + 1] for k in range(n)]
-    l, b = [ca.sqrt(c[0])], []
-    for k in range(1, n):
-        b.append(-v[k] / l[k - 1])
-        l.append(ca.sqrt(c[k] - b[-1] ** 2))
-    return ca.vertcat(*l), (ca.vertcat(*b) if b else ca.SX(0, 1))
+    if isinstance(v, ca.SX):
+        c = [sm2 + v[k] + v[k + 1] for k in range(n)]
+        l, b = [ca.sqrt(c[0])], []
+        for k in range(1, n):
+            b.append(-v[k] / l[k - 1])
+            l.append(ca.sqrt(c[k] - b[-1] ** 2))
+        return ca.vertcat(*l), (ca.vertcat(*b) if b else ca.SX(0, 1))
+    c = sm2 + v[:-1] + v[1:]
+    l0 = ca.sqrt(c[0])
+    if n == 1:
+        return l0, ca.MX(0, 1)
+    lp, ck, vk = (ca.SX.sym(s) for s in ("l", "c", "v"))
+    bk = -vk / lp
+    step = ca.Function("chol_step", [lp, ck, vk], [ca.sqrt(ck - bk**2), bk])
+    lr, br = step.mapaccum("chol", n - 1)(l0, c[1:].T, v[1:-1].T)
+    return ca.vertcat(l0, lr.T), br.T
 
 
 class NllsProblem:
@@ -92,17 +119,19 @@ class NllsProblem:
         rho1 = f(th1, g1, e1)
         pose = ca.Function("pose", [th1, g1, e1], [rho1, ca.sumsqr(ca.jacobian(rho1, th1))])
         pose_k = pose.map(K)
+        X = ca.SX if K <= EXPAND_MAX_K else ca.MX
+        self.expanded = X is ca.SX
 
-        z = ca.SX.sym("z", p)
-        th = ca.SX.sym("theta", m, K)
-        g = ca.SX.sym("g", G)
-        efix = ca.SX.sym("err_fixed", q)
-        s = ca.SX.sym("s", K - 1)
-        sc = ca.SX.sym("scale", p)          # p = z / sc
-        mu = ca.SX.sym("prior_mean", p)
-        w = ca.SX.sym("prior_W", p, p)      # prior whitener (physical units), 0 = no prior
-        sm2 = ca.SX.sym("sigma_m2")
-        sx2 = ca.SX.sym("sigma_xi2")
+        z = X.sym("z", p)
+        th = X.sym("theta", m, K)
+        g = X.sym("g", G)
+        efix = X.sym("err_fixed", q)
+        s = X.sym("s", K - 1)
+        sc = X.sym("scale", p)          # p = z / sc
+        mu = X.sym("prior_mean", p)
+        w = X.sym("prior_W", p, p)      # prior whitener (physical units), 0 = no prior
+        sm2 = X.sym("sigma_m2")
+        sx2 = X.sym("sigma_xi2")
         par = ca.vertcat(ca.vec(th), g, efix, s, sc, mu, ca.vec(w), sm2, sx2)
         self.npar = par.numel()
         E = np.zeros((q, p))
@@ -116,8 +145,8 @@ class NllsProblem:
         l, b = _banded_cholesky(sx2 * dth2.T, sm2)
         self.weights = ca.Function("weights", [z, par], [l, b], ["z", "p"], ["l", "b"])
 
-        L = ca.SX.sym("l", K - 1)
-        B = ca.SX.sym("b", max(K - 2, 0))
+        L = X.sym("l", K - 1)
+        B = X.sym("b", max(K - 2, 0))
         r = _banded_whiten(s - pred, L, B)
         rp = ca.mtimes(w, pz - mu)
         res = ca.vertcat(r, rp)
@@ -130,7 +159,8 @@ class NllsProblem:
         # one damped Gauss-Newton step; weights at z (reweight) or given
         JtJ = ca.mtimes(J.T, J)
         ridge = 1e-12 * (ca.mmax(ca.diag(JtJ)) + 1e-300)
-        dz = -ca.solve(JtJ + ridge * ca.SX.eye(p), ca.mtimes(J.T, res))
+        A, rhs = JtJ + ridge * X.eye(p), ca.mtimes(J.T, res)
+        dz = -(ca.solve(A, rhs) if self.expanded else ca.solve(A, rhs, "qr"))
         step_fixed = ca.Function("gn_step_fixed", [z, par, L, B], [z + dz, ca.norm_inf(dz)])
         lz, bz = self.weights(z, par)
         zn, dn = step_fixed(z, par, lz, bz)
@@ -146,20 +176,25 @@ class NllsProblem:
             lk, bk = self.weights(zk, pp) if reweight else (lx, bx)
             rk, rpk, Jk, predk = self.residuals(zk, pp, lk, bk)
             ins, names = ([z0, pp], ["z0", "p"]) if reweight else ([z0, pp, lx, bx], ["z0", "p", "l0", "b0"])
-            return ca.Function("gauss_newton", ins, [zk, dk, rk, rpk, Jk, predk, lk, bk],
-                               names, ["z", "last_step", "r", "r_prior", "J", "pred", "l", "b"]).expand()
+            fn = ca.Function("gauss_newton", ins, [zk, dk, rk, rpk, Jk, predk, lk, bk],
+                             names, ["z", "last_step", "r", "r_prior", "J", "pred", "l", "b"])
+            return fn.expand() if self.expanded else fn
 
         self.gauss_newton = unroll(True)
         self.gauss_newton_fixed = unroll(False)
 
-        c = ca.SX.sym("obj_scale")
+        c = X.sym("obj_scale")
         nlp = {"x": z, "p": ca.vertcat(par, L, B, c), "f": 0.5 * c * ca.dot(res, res)}
-        sigma = ca.SX.sym("lam_f")
+        sigma = X.sym("lam_f")
         H = ca.triu(sigma * c * JtJ)
-        self._hess = ca.Function("nlp_hess_l", [z, nlp["p"], sigma, ca.SX.sym("lam_g", 0)], [H],
+        self._hess = ca.Function("nlp_hess_l", [z, nlp["p"], sigma, X.sym("lam_g", 0)], [H],
                                  ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])
         self._nlp, self._solvers = nlp, {}
         self._batch = {}
+        # symbols kept for the robust-loss problem (built on first use, see robust())
+        self._sym = {"z": z, "par": par, "pred": pred, "dth2": dth2, "pz": pz, "w": w, "mu": mu, "s": s,
+                     "sm2": sm2, "sx2": sx2}
+        self._robust = {}
         # zero-copy callers of the functions identify_nlls calls every time
         self.fast = {name: FastCall(getattr(self, name))
                      for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun")}
