@@ -200,3 +200,20 @@ def test_batch_hands_unconfirmed_sets_to_the_single_path(robot, th6):
     b = identify_batch(robot, th6, np.array([good, wild]), noise=NoiseModel.paper())
     assert b.confirmed[0] and b.success[0]
     assert not b.confirmed[1]  # decided by identify_nlls, whatever its verdict
+
+
+def test_large_k_graph_gives_the_same_answer(robot, monkeypatch):
+    """Above EXPAND_MAX_K the problem is an MX graph (mapped model, mapaccum recurrences): same answer."""
+    from zerocal_sym.identify import nlls_problem
+
+    th = kin.ik(robot, paper_poses(robot, 5))
+    noise = NoiseModel.paper()
+    m = Measurements(th, VirtualPlant(robot, table2_errors(1)).measure(th, noise, 3))
+    small = identify_nlls(robot, m, noise=noise)
+    monkeypatch.setattr(nlls_problem, "EXPAND_MAX_K", 5)
+    monkeypatch.setattr(nlls_problem, "_CACHE", {})
+    assert not get_problem(robot, 10, "paper").expanded
+    big = identify_nlls(robot, m, noise=noise)
+    assert big.success
+    np.testing.assert_allclose(big.zero_offsets_deg, small.zero_offsets_deg, atol=1e-9)
+    np.testing.assert_allclose(big.std_zero_offsets_deg, small.std_zero_offsets_deg, rtol=1e-9)
