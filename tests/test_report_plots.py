@@ -131,13 +131,14 @@ def test_pngs_written_atomically(robot, tmp_path):
 
 def test_command_level_plot_sets(robot, tmp_path):
     from zerocal_sym.paper import reproduction as paper
+    from zerocal_sym.paper.figures import reproduce_plots
 
     meas = data.load_measurements(EXAMPLE, robot)
     res = identify_tsvd(robot, meas)
     d = rp.identify_plots(tmp_path / "id", res, meas, robot)
     assert list(d) == ["residuals.png"] and (tmp_path / "id" / "residuals.png").read_bytes()[:8] == PNG
     rep = paper.reproduce(robot, trials=1, groups=(1, 3), max_iter=4)
-    d = rp.reproduce_plots(tmp_path / "rep", rep, robot)
+    d = reproduce_plots(tmp_path / "rep", rep, robot)
     assert sorted(d) == ["convergence_group1.png", "convergence_group3.png", "fig12_group1.png", "fig12_group3.png"]
     for name in d:
         assert (tmp_path / "rep" / name).read_bytes()[:8] == PNG

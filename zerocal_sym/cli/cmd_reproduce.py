@@ -65,7 +65,7 @@ def _write_out(out_dir, rep, robot, n):
 
     from zerocal_sym.io.files import write_json
     from zerocal_sym.paper.figures import fig8, fig8_data, fig9
-    from zerocal_sym.report.plots import reproduce_plots
+    from zerocal_sym.paper.figures import reproduce_plots
 
     out = Path(out_dir)
     if out.exists() and not out.is_dir():

@@ -1,4 +1,4 @@
-"""The paper's Figs. 8 and 9 as PNG files (matplotlib, Agg backend).
+"""The paper's Figs. 8, 9 and the per-group Fig. 12 / convergence plots as PNG files (matplotlib, Agg backend).
 
 matplotlib is imported inside the functions so that importing this module (and
 the CLI) stays light.
@@ -115,3 +115,50 @@ def fig9(path, groups: list, mu0_deg=0.1) -> None:
     fig.tight_layout()
     fig.savefig(path, format="png")
     plt.close(fig)
+
+
+def reproduce_plots(out_dir, rep: dict, robot=None, K: int = 42) -> dict:
+    """The per-group plots of a reproduction (``zerocal reproduce --plot DIR``).
+
+    For each group of ``rep`` (:func:`zerocal_sym.paper.reproduction.reproduce`): the
+    position error over the K boundary positions before and after its
+    compensation value (Fig. 12 style, ``fig12_group{g}.png``) and the
+    convergence of the compensation values of its first trial
+    (``convergence_group{g}.png``).  Offsets are converted from Table 2's frame
+    (``rep["settings"]["frame"]``) to the robot's for the plant.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+    rep : dict
+        From :func:`zerocal_sym.paper.reproduction.reproduce`.
+    robot : Robot, optional
+        Default: the paper's.
+    K : int
+        Number of boundary positions.
+
+    Returns
+    -------
+    dict
+        file name -> the figure's data.
+    """
+    from pathlib import Path
+
+    from zerocal_sym.model.robot import paper_robot
+    from zerocal_sym.paper.tables import group_errors, to_table_frame
+    from zerocal_sym.report.plots import plot_boundary_errors, plot_convergence
+
+    robot = robot or paper_robot()
+    out_dir = Path(out_dir)
+    frame = rep["settings"]["frame"]
+    out = {}
+    for g in rep["groups"]:
+        n = int(g["group"])
+        comp = to_table_frame(np.asarray(g["compensation_deg"], float), frame, "offsets")  # an involution
+        name = f"fig12_group{n}.png"
+        out[name] = plot_boundary_errors(robot, group_errors(n, frame), comp, out_dir / name, K=K,
+                                         title=f"Group {n}: position error over the boundary (Fig. 12 style)")
+        name = f"convergence_group{n}.png"
+        out[name] = plot_convergence(g["history"], out_dir / name, set_values_deg=g["set_deg"],
+                                     mu0_deg=rep["settings"].get("mu0_deg", 0.1))
+    return out

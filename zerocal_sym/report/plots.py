@@ -290,11 +290,11 @@ def convergence_data(history, set_values_deg=None) -> dict:
     Parameters
     ----------
     history : LoopResult, sequence or dict
-        A :class:`~zerocal_sym.paper.LoopResult` (its ``history``), a sequence
+        A :class:`~zerocal_sym.identify.loop.LoopResult` (its ``history``), a sequence
         with one entry per identification round (mappings or objects with
         ``compensation_deg`` (m,): the compensation value after that round,
         i.e. the sum of the increments, deg; or ``compensation`` in rad), or
-        the ``history`` dict of :func:`zerocal_sym.paper.run_group` (a dict
+        the ``history`` dict of :func:`zerocal_sym.paper.reproduction.run_group` (a dict
         with a list ``compensation_deg``).
     set_values_deg : array_like, shape (m,), optional
         True zero offsets (simulation): also ``delta_deg``, the absolute
@@ -390,50 +390,4 @@ def identify_plots(out_dir, result, meas, robot, err_true=None) -> dict:
         out["boundary_errors.png"] = plot_boundary_errors(
             robot, err_true, result.zero_offsets_deg, out_dir / "boundary_errors.png",
             title=f"Boundary position error (simulated truth), {result.method} compensation")
-    return out
-
-
-def reproduce_plots(out_dir, rep: dict, robot=None, K: int = 42) -> dict:
-    """The per-group plots of a reproduction (``zerocal reproduce --plot DIR``).
-
-    For each group of ``rep`` (:func:`zerocal_sym.paper.reproduce`): the
-    position error over the K boundary positions before and after its
-    compensation value (Fig. 12 style, ``fig12_group{g}.png``) and the
-    convergence of the compensation values of its first trial
-    (``convergence_group{g}.png``).  Offsets are converted from Table 2's frame
-    (``rep["settings"]["frame"]``) to the robot's for the plant.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-    rep : dict
-        From :func:`zerocal_sym.paper.reproduce`.
-    robot : Robot, optional
-        Default: the paper's.
-    K : int
-        Number of boundary positions.
-
-    Returns
-    -------
-    dict
-        file name -> the figure's data.
-    """
-    from pathlib import Path
-
-    from zerocal_sym.paper.tables import group_errors, to_table_frame
-    from zerocal_sym.model.robot import paper_robot
-
-    robot = robot or paper_robot()
-    out_dir = Path(out_dir)
-    frame = rep["settings"]["frame"]
-    out = {}
-    for g in rep["groups"]:
-        n = int(g["group"])
-        comp = to_table_frame(np.asarray(g["compensation_deg"], float), frame, "offsets")  # an involution
-        name = f"fig12_group{n}.png"
-        out[name] = plot_boundary_errors(robot, group_errors(n, frame), comp, out_dir / name, K=K,
-                                         title=f"Group {n}: position error over the boundary (Fig. 12 style)")
-        name = f"convergence_group{n}.png"
-        out[name] = plot_convergence(g["history"], out_dir / name, set_values_deg=g["set_deg"],
-                                     mu0_deg=rep["settings"].get("mu0_deg", 0.1))
     return out
