@@ -6,17 +6,31 @@ that defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args)``
 ``run`` so that ``zerocal --help`` stays fast.
 
 Exit status: 0 success, 1 a check that failed (``regen --check``), 2 a user
-error (bad file, bad pose, bad option): one line on stderr, no traceback, no
-output file written.
+error (bad file, bad pose, bad option, an option that does not apply to the
+chosen mode, an output that is an input): one line on stderr, no traceback,
+no output file written; 130 interrupted (Ctrl-C), nothing written; 141 the
+reader of the standard output went away (``zerocal ... | head -1``): quietly,
+as a program killed by SIGPIPE.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 
 from zerocal_sym.errors import ZerocalError
+
+#: exit status when the standard output was closed by its reader (128 + SIGPIPE)
+EXIT_BROKEN_PIPE = 141
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the CLI's one-line errors (exit status 2)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
 def _command_modules():
@@ -26,11 +40,11 @@ def _command_modules():
 
 
 def build_parser() -> argparse.ArgumentParser:
-    common = argparse.ArgumentParser(add_help=False)
+    common = _Parser(add_help=False)
     common.add_argument("--robot", metavar="FILE", default=None,
                         help="robot TOML file, any mechanism (default: the paper's robot, Table 1; "
                              "examples/delta.toml: the rotary Delta)")
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="zerocal",
         description="Zero-offset calibration of parallel robots (Mei et al. 2017, and beyond).")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -49,16 +63,42 @@ def load_robot_arg(args):
     return load_robot(args.robot) if args.robot else paper_robot()
 
 
+def _given_options(argv) -> set:
+    """The destinations of the options given on the command line (not left at their defaults)."""
+    parser = build_parser()
+    stack = [parser]
+    while stack:
+        p = stack.pop()
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                stack.extend(action.choices.values())
+            else:
+                action.default = argparse.SUPPRESS
+    return set(vars(parser.parse_args(argv)))
+
+
 def main(argv=None) -> int:
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
     try:
-        return int(args._run(args) or 0)
+        from zerocal_sym.cli._checks import check_args
+
+        args._given = _given_options(argv)
+        check_args(args)  # options of the mode, numbers, outputs vs inputs: before any work
+        status = int(args._run(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return status
     except ZerocalError as exc:
         print(f"zerocal {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError as exc:
+        if exc.filename is None:  # our standard output: its reader has gone (| head -1)
+            return _stdout_closed()
+        print(f"zerocal {args.command}: error: {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
         return 2
     except OSError as exc:  # an unwritable --out, a directory given for a file, a full disk
         where = f"{exc.filename}: " if exc.filename else ""
@@ -69,5 +109,23 @@ def main(argv=None) -> int:
         return 130
 
 
+def _stdout_closed() -> int:
+    """The reader of stdout went away: point stdout at /dev/null (no error at exit), status 141."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError):  # not a real file (captured in tests)
+        pass
+    return EXIT_BROKEN_PIPE
+
+
 def entry() -> None:  # console script
-    sys.exit(main())
+    try:
+        status = main()
+    except KeyboardInterrupt:  # before a command ran (while parsing, importing)
+        print("zerocal: interrupted", file=sys.stderr)
+        status = 130
+    except BrokenPipeError:
+        status = _stdout_closed()
+    sys.exit(status)

@@ -95,6 +95,56 @@ def poses_arg(robot, spec, n, identifiable: bool = True):
     return load_poses(spec, robot), str(spec)
 
 
+def check_round_poses(robot, P, theta_cmd, source: str) -> None:
+    """Refuse a measurement round (``compensate --template``) that identify would refuse.
+
+    The checks of ``zerocal identify`` on the poses themselves: enough poses
+    for the p = m + n parameters (and the loader's minimum), every pose
+    inside the workspace, reachable and away from singular configurations
+    (the robot's singularity margin), no pose repeated, the poses not on one
+    line, and the paper's identification matrix G of full rank.
+
+    Raises
+    ------
+    PoseError
+        Naming ``source`` (the pose file or the scheme) and the pose.
+    """
+    import numpy as np
+
+    from zerocal_sym.errors import PoseError
+    from zerocal_sym.identify.linear import identification_matrix
+    from zerocal_sym.identify.tsvd import COLLINEAR_RTOL, RANK_RTOL
+    from zerocal_sym.io.measurements import MIN_POSES, first_duplicate
+    from zerocal_sym.model import kinematics as kin
+
+    K, p = len(P), n_params(robot)
+    names = ", ".join(robot.errors.resolve("offsets+measuring"))
+    need = max(MIN_POSES, p + 1)
+    why = "identify would refuse this measurement round"
+    if K < need:
+        raise PoseError(f"{K} poses give {K - 1} measured changes: too few for the {p} parameters ({names}); a "
+                        f"measurement round needs at least {need} poses ({why})", where=source)
+    try:
+        theta = kin.check_poses(robot, P, in_workspace=True)
+    except PoseError as exc:
+        raise PoseError(f"{exc.where}: {exc.message} ({why})" if exc.where else f"{exc.message} ({why})",
+                        where=source) from None
+    for what, X, tol in (("commanded joint angles", np.degrees(theta_cmd), 1e-9), ("target", P, 1e-9)):
+        dup = first_duplicate(X, tol)
+        if dup is not None:
+            k, j = dup
+            raise PoseError(f"pose {k}: repeats the {what} of pose {j} ({why})", where=source)
+    spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
+    if spread[1] <= COLLINEAR_RTOL * spread[0]:
+        raise PoseError(f"the {K} poses lie on one straight line: the offsets and the MAEMM are not identifiable "
+                        f"from them ({why})", where=source)
+    G, _ = identification_matrix(robot, P, theta=theta)
+    s = np.linalg.svd(G, compute_uv=False)
+    if not s[-1] > RANK_RTOL * s[0]:
+        raise PoseError(f"the identification matrix G of these poses has rank {int(np.sum(s > RANK_RTOL * s[0]))} "
+                        f"< {p}: the parameters {names} are not identifiable from them ({why})", where=source)
+
+
 # --------------------------------------------------------------------------- values by name
 
 def parse_named_values(items, robot, option: str = "--set") -> dict:

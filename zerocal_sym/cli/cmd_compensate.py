@@ -60,7 +60,7 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.cli._common import scheme_poses
+    from zerocal_sym.cli._common import check_round_poses, scheme_poses
     from zerocal_sym.errors import DataFileError, ZerocalError
     from zerocal_sym.io.compensation import (SIGN_CONVENTION, compensated_commands, format_commands,
                                              format_compensation, format_offsets)
@@ -99,12 +99,14 @@ def run(args):
         text, what, K = format_compensation(res, {"result": args.result}, mechanism=robot), "compensation table", 0
     else:
         if args.poses is not None:
-            P = load_poses(args.poses, robot)
+            P, source = load_poses(args.poses, robot), args.poses
         else:
-            P, _ = scheme_poses(robot, args.scheme, args.n, identifiable=False)
+            P, n = scheme_poses(robot, args.scheme, args.n, identifiable=args.template)
+            source = f"--scheme {args.scheme} --n {n}"
         nominal, cmd = compensated_commands(robot, P, offsets)
         K = len(P)
-        if args.template:
+        if args.template:  # a round identify would refuse is refused now, not after the measurements
+            check_round_poses(robot, P, cmd, source)
             meta["compensation_deg"] = format_offsets(offsets)
             text, what = format_template(cmd, P, meta, mechanism=robot), "measurement template"
         else:

@@ -147,12 +147,13 @@ def print_estimate(robot, res) -> None:
 
 
 def run(args):
+    import contextlib
     import sys
 
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.identify.identifiability import format_report, identifiability_report
-    from zerocal_sym.io.files import to_json, write_json
+    from zerocal_sym.io.files import staged_directory, to_json, write_json
     from zerocal_sym.io.measurements import load_measurements
     from zerocal_sym.model.noise import NoiseModel
 
@@ -209,13 +210,14 @@ def run(args):
         print(f"zerocal identify: identification failed ({res.method}): {res.status}; no calibration written",
               file=sys.stderr)
         return 1
-    if args.plot:
-        from zerocal_sym.cli._common import truth_from_meta
-        from zerocal_sym.report.plots import identify_plots
+    with staged_directory(args.plot) if args.plot else contextlib.nullcontext() as plot_dir:
+        if args.plot:  # into a temporary directory, moved into place once everything is written
+            from zerocal_sym.cli._common import truth_from_meta
+            from zerocal_sym.report.plots import identify_plots
 
-        identify_plots(args.plot, res, meas, robot, err_true=truth_from_meta(meas, robot))
-    if args.out:
-        write_json(args.out, out)
+            identify_plots(plot_dir, res, meas, robot, err_true=truth_from_meta(meas, robot))
+        if args.out:
+            write_json(args.out, out)
     if args.json:
         print(to_json(out))
         return 0

@@ -58,43 +58,16 @@ def _progress(total):
 
 
 def _write_out(out_dir, rep, robot, n):
-    import os
-    import shutil
-    import tempfile
-    from pathlib import Path
+    """The figures and results.json into ``out_dir``, all or nothing (:func:`zerocal_sym.io.files.staged_directory`)."""
+    from zerocal_sym.io.files import staged_directory, write_json
+    from zerocal_sym.paper.figures import fig8, fig8_data, fig9, reproduce_plots
 
-    from zerocal_sym.io.files import write_json
-    from zerocal_sym.paper.figures import fig8, fig8_data, fig9
-    from zerocal_sym.paper.figures import reproduce_plots
-
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        from zerocal_sym.errors import ZerocalError
-
-        raise ZerocalError("--out exists and is not a directory", where=str(out))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with staged_directory(out_dir) as tmp:
         d8 = fig8_data(robot, range(3, 22))
         fig8(tmp / "fig8.png", d8)
         fig9(tmp / "fig9.png", rep["groups"], rep["settings"]["mu0_deg"])
         reproduce_plots(tmp, rep, robot)
         write_json(tmp / "results.json", dict(rep, fig8=d8))
-        names = sorted(p.name for p in tmp.iterdir())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o777 & ~umask)
-        for name in names:
-            os.chmod(tmp / name, 0o666 & ~umask)
-        if not out.exists():
-            os.rename(tmp, out)
-        else:
-            for name in names:
-                os.replace(tmp / name, out / name)
-            tmp.rmdir()
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def run(args):
@@ -123,11 +96,6 @@ def run(args):
     identify = functools.partial(identify_tsvd, t=args.truncation, rule=args.rule,
                                  noise=NoiseModel.named(args.noise))
     identify.__name__ = f"identify_tsvd(t={args.truncation}, rule={args.rule})"
-    if args.out:
-        from pathlib import Path
-
-        if Path(args.out).exists() and not Path(args.out).is_dir():
-            raise ZerocalError("--out exists and is not a directory", where=args.out)
     total = 6 * args.trials
     progress = _progress(total) if total > 6 else None
     rep = reproduce(robot, seed=args.seed, trials=args.trials, noise=args.noise, n=args.n, frame=args.frame,

@@ -38,6 +38,8 @@ def add_arguments(p):
 
 
 def run(args):
+    import contextlib
+
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
@@ -45,7 +47,7 @@ def run(args):
     from zerocal_sym.cli.cmd_identify import compensation_block
     from zerocal_sym.errors import DataFileError, ZerocalError
     from zerocal_sym.io.compensation import parse_offsets
-    from zerocal_sym.io.files import json_safe, to_json, write_json
+    from zerocal_sym.io.files import json_safe, staged_directory, to_json, write_json
     from zerocal_sym.io.measurements import load_measurements
     from zerocal_sym.io.results import load_result
     from zerocal_sym.model.noise import NoiseModel
@@ -109,15 +111,17 @@ def run(args):
                compensation=compensation_block(robot, res))
     target = args.plot
     try:
-        if args.plot:
-            from zerocal_sym.report.plots import identify_plots
+        with staged_directory(args.plot) if args.plot else contextlib.nullcontext() as plot_dir:
+            if args.plot:  # into a temporary directory, moved into place once everything is written
+                from zerocal_sym.report.plots import identify_plots
 
-            identify_plots(args.plot, res, meas, robot)
-        target = args.out
-        if args.out:
-            write_json(args.out, json_safe(out))
+                identify_plots(plot_dir, res, meas, robot)
+            target = args.out
+            if args.out:
+                write_json(args.out, json_safe(out))
+            target = args.plot
     except OSError as exc:
-        raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=target) from None
+        raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=exc.filename or target) from None
     if args.json:
         print(to_json(json_safe(out)))
     else:

@@ -95,10 +95,13 @@ def _split_csv(text: str, src: str, format_prefix: str | None = None, version: i
                 meta[k.strip()] = v.strip()
                 meta_lines[k.strip()] = lineno
             continue
-        try:
-            cells = next(csv.reader([line], strict=True))
-        except csv.Error as exc:
-            raise DataFileError(f"malformed CSV line ({exc})", where=f"{src}:{lineno}") from None
+        if '"' in line:  # quoting: the csv module (a line without quotes splits at every comma alike)
+            try:
+                cells = next(csv.reader([line], strict=True))
+            except csv.Error as exc:
+                raise DataFileError(f"malformed CSV line ({exc})", where=f"{src}:{lineno}") from None
+        else:
+            cells = line.split(",")
         rows.append((lineno, [c.strip() for c in cells]))
         header_seen = True
     return meta, meta_lines, rows
@@ -175,19 +178,60 @@ def _rows_to_records(rows, cols, src, int_cols=("pose",)):
     return values, lines
 
 
+def _rows_to_array(rows, cols, src, int_cols=("pose",)):
+    """The cells as numbers, shape (N, len(cols)), and the line of each row; linear time.
+
+    Every row is checked as :func:`_rows_to_records` checks it (the number of
+    fields, numbers, finite, in the plausible range, whole numbers in
+    ``int_cols``); the first row at fault is re-read by it for the message.
+    """
+    import numpy as np
+
+    n = len(cols)
+    V = np.empty((len(rows), n))
+    lines = [lineno for lineno, _ in rows]
+    for i, (_, cells) in enumerate(rows):
+        try:
+            if len(cells) != n:
+                raise ValueError
+            V[i] = [float(c) for c in cells]
+        except ValueError:
+            _rows_to_records([rows[i]], cols, src, int_cols)  # raises the message of this row
+            raise
+    limit = np.array([np.inf if c == "pose" else ANGLE_LIMIT_DEG if c.endswith("_deg") else LENGTH_LIMIT_MM
+                      for c in cols])
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(V) <= limit)  # NaN and inf too
+        for c in int_cols:
+            if c in cols:
+                j = cols.index(c)
+                bad[:, j] |= V[:, j] != np.floor(V[:, j])
+    first = np.flatnonzero(bad.any(axis=1))
+    if first.size:
+        _rows_to_records([rows[int(first[0])]], cols, src, int_cols)  # raises the message of this row
+    return V, lines
+
+
 def _check_pose_numbers(values, lines, src, col_index):
-    """Poses numbered 0, 1, ... in file order; the first deviation is reported."""
-    first = {}
-    for k, rec in enumerate(values):
-        p = int(rec["pose"])
-        if p != k:
-            if p in first:
-                msg = f"pose {p} appears twice (lines {first[p]} and {lines[k]})"
-            else:
-                msg = f"expected {k}, got {p}" + (" (numbering starts at 0)" if k == 0 and p == 1 else "")
-            raise DataFileError(f"column 'pose' (field {col_index}): {msg}; poses are numbered 0, 1, ... in "
-                                "visiting order, one row each", where=f"{src}:{lines[k]}")
-        first[p] = lines[k]
+    """Poses numbered 0, 1, ... in file order; the first deviation is reported.
+
+    ``values``: the records of :func:`_rows_to_records`, or the pose column (an array).
+    """
+    import numpy as np
+
+    poses = (np.asarray(values, float) if not (len(values) and isinstance(values[0], dict))
+             else np.array([rec["pose"] for rec in values], float))
+    wrong = np.flatnonzero(poses != np.arange(len(poses)))
+    if not wrong.size:
+        return
+    k = int(wrong[0])
+    p = int(poses[k])
+    if 0 <= p < k:  # the rows before k are numbered 0..k-1: p is one of them
+        msg = f"pose {p} appears twice (lines {lines[p]} and {lines[k]})"
+    else:
+        msg = f"expected {k}, got {p}" + (" (numbering starts at 0)" if k == 0 and p == 1 else "")
+    raise DataFileError(f"column 'pose' (field {col_index}): {msg}; poses are numbered 0, 1, ... in "
+                        "visiting order, one row each", where=f"{src}:{lines[k]}")
 
 
 def _reject_constant(c):

@@ -43,13 +43,14 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import (MECHANISM_KEY, _check_header, _check_pose_numbers, _format_meta, _go_together,
-                                    _read_text, _rows_to_records, _split_csv, get_mechanism_of, infer_mechanism,
+                                    _read_text, _rows_to_array, _split_csv, get_mechanism_of, infer_mechanism,
                                     joint_columns, mechanism_for_shape, pose_columns)
 from zerocal_sym.io.files import atomic_write_text
 from zerocal_sym.model.measurements import Measurements, _check_arrays
@@ -287,16 +288,17 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     data = rows[1:]
     if not data:
         raise DataFileError("no data rows after the header", where=f"{src}:{header_line}")
-    values, lines = _rows_to_records(data, header, src)
-    _check_pose_numbers(values, lines, src, header.index("pose") + 1)
-    K = len(values)
-    if values[0]["reading_mm"] != 0.0:
-        raise DataFileError(f"column 'reading_mm' (field {header.index('reading_mm') + 1}): the reading at pose 0 "
-                            f"must be 0 (the head is reset there), got {values[0]['reading_mm']:g}",
+    V, lines = _rows_to_array(data, header, src)
+    col = {c: j for j, c in enumerate(header)}
+    _check_pose_numbers(V[:, col["pose"]], lines, src, col["pose"] + 1)
+    K = len(V)
+    if V[0, col["reading_mm"]] != 0.0:
+        raise DataFileError(f"column 'reading_mm' (field {col['reading_mm'] + 1}): the reading at pose 0 "
+                            f"must be 0 (the head is reset there), got {V[0, col['reading_mm']]:g}",
                             where=f"{src}:{lines[0]}")
-    theta = np.radians(np.array([[r[c] for c in cols.joints] for r in values]))
-    readings = np.array([r["reading_mm"] for r in values])
-    target = np.array([[r[c] for c in cols.pose] for r in values]) if all(has_pose) else None
+    theta = np.radians(V[:, [col[c] for c in cols.joints]])
+    readings = V[:, col["reading_mm"]].copy()
+    target = V[:, [col[c] for c in cols.pose]] if all(has_pose) else None
     meas = Measurements(theta, readings, target, meta, src, lines, meta_lines, mech.name)
     if K < min_poses:
         raise DataFileError(f"too few poses: {K} (at least {min_poses} are needed to identify the parameters)",
@@ -336,20 +338,95 @@ def _check_columns_fit_robot(header, where, robot) -> None:
                             "the measured robot", where=where)
 
 
-def _check_duplicates(meas: Measurements, cols: MeasurementColumns) -> None:
-    deg = np.degrees(meas.theta_cmd)
-    for k in range(1, meas.K):
-        d = np.max(np.abs(deg[:k] - deg[k]), axis=1)
+#: odd multipliers of the cell hash (fixed: the result never depends on them, only the speed)
+_HASH = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0xD6E8FEB86659FD93,
+                  0xFF51AFD7ED558CCD, 0xC4CEB9FE1A85EC53], np.uint64)
+
+
+def _first_duplicate_scan(X, tol):
+    for k in range(1, X.shape[0]):
+        d = np.max(np.abs(X[:k] - X[k]), axis=1)
         j = int(np.argmin(d))
-        if d[j] <= DUPLICATE_TOL_DEG:
-            raise DataFileError(f"duplicated pose: pose {k} repeats the commanded joint angles of pose {j} "
-                                f"(line {meas.lines[j]})", where=meas.where(k))
-        if meas.target is not None:
-            dt = np.max(np.abs(meas.target[:k] - meas.target[k]), axis=1)
-            j = int(np.argmin(dt))
-            if dt[j] <= 1e-9:
-                raise DataFileError(f"duplicated pose: pose {k} repeats the target ({', '.join(cols.pose)}) of "
-                                    f"pose {j} (line {meas.lines[j]})", where=meas.where(k))
+        if d[j] <= tol:
+            return k, j
+    return None
+
+
+def first_duplicate(X, tol: float):
+    """The first row that repeats an earlier one: ``(k, j)`` or None.
+
+    ``k`` is the smallest index with an earlier row ``j`` within ``tol`` in
+    every column (``max |X_j - X_k| <= tol``), ``j`` the nearest such row (the
+    first of equals).  O(3^d K log K) in time and O(K d) in memory: rows are
+    put in cells of side ``tol`` (hashed); a repeat lies in the same or a
+    neighbouring cell.
+
+    Parameters
+    ----------
+    X : ndarray, shape (K, d)
+        Finite values.
+    tol : float
+        > 0.
+    """
+    from itertools import product
+
+    X = np.asarray(X, float)
+    if X.ndim == 1:
+        X = X[:, None]
+    K, d = X.shape
+    if K < 2:
+        return None
+    if not (np.all(np.isfinite(X)) and tol > 0) or float(np.max(np.abs(X))) / tol >= 2.0**50:
+        return _first_duplicate_scan(X, tol)
+    keys = np.floor(X / tol).astype(np.int64).view(np.uint64)
+    if d > len(_HASH):
+        return _first_duplicate_scan(X, tol)
+    mult = _HASH[:d]
+    with np.errstate(over="ignore"):
+        code = (keys * mult).sum(axis=1, dtype=np.uint64)  # wraps: a hash, linear in the cell indices
+    order = np.argsort(code, kind="stable")
+    sc = code[order]
+    eq = np.flatnonzero(sc[1:] == sc[:-1])
+    if eq.size and np.any(keys[order[eq]] != keys[order[eq + 1]]):  # two cells with one hash: exact fallback
+        return _first_duplicate_scan(X, tol)
+    best = int(order[eq + 1].min()) if eq.size else K  # same cell (side tol): a repeat for certain
+    # below ``best`` every cell holds one row: a neighbouring cell has at most one candidate
+    n0 = best
+    oR = np.argsort(code[:n0], kind="stable")
+    scR = code[:n0][oR]
+    for off in product((-1, 0, 1), repeat=d):
+        nz = [o for o in off if o]
+        if not nz or nz[0] < 0 or n0 < 2:  # each pair once: (i, j) by +off is (j, i) by -off
+            continue
+        with np.errstate(over="ignore"):
+            shift = (np.asarray(off, np.int64).view(np.uint64) * mult).sum(dtype=np.uint64)
+            q = code[:n0] + shift
+        pos = np.minimum(np.searchsorted(scR, q), n0 - 1)
+        hit = np.flatnonzero(scR[pos] == q)
+        i, j = hit, oR[pos[hit]]
+        close = np.max(np.abs(X[i] - X[j]), axis=1) <= tol
+        if np.any(close):
+            best = min(best, int(np.maximum(i[close], j[close]).min()))
+    if best >= K:
+        return None
+    dist = np.max(np.abs(X[:best] - X[best]), axis=1)
+    return best, int(np.argmin(dist))
+
+
+def _check_duplicates(meas: Measurements, cols: MeasurementColumns) -> None:
+    """A pose that repeats an earlier one (commanded angles to 1e-9 deg, or the target to 1e-9 mm)."""
+    found = [("angles", first_duplicate(np.degrees(meas.theta_cmd), DUPLICATE_TOL_DEG))]
+    if meas.target is not None:
+        found.append(("target", first_duplicate(meas.target, 1e-9)))
+    found = [(kj, what) for what, kj in found if kj is not None]
+    if not found:
+        return
+    (k, j), what = min(found, key=lambda f: f[0][0])  # the first pose; the angles first (min is stable)
+    if what == "angles":
+        raise DataFileError(f"duplicated pose: pose {k} repeats the commanded joint angles of pose {j} "
+                            f"(line {meas.lines[j]})", where=meas.where(k))
+    raise DataFileError(f"duplicated pose: pose {k} repeats the target ({', '.join(cols.pose)}) of "
+                        f"pose {j} (line {meas.lines[j]})", where=meas.where(k))
 
 
 def check_against_robot(meas: Measurements, robot) -> None:
@@ -384,7 +461,11 @@ def check_against_robot(meas: Measurements, robot) -> None:
         P = kin.fk(robot, meas.theta_cmd)
     ws = robot.workspace
     target_what = f"target ({', '.join(cols.pose)})"
-    for k in range(meas.K):
+    with np.errstate(invalid="ignore"):  # all poses at once; the first bad one is reported below
+        bad = ~np.all(np.isfinite(P), axis=1) | ~ws.contains(P, WORKSPACE_TOL_MM)
+        if meas.target is not None:
+            bad |= ~ws.contains(meas.target, 1e-6) | ~(np.linalg.norm(P - meas.target, axis=1) <= TARGET_TOL_MM)
+    for k in map(int, np.flatnonzero(bad)[:1]):
         if not np.all(np.isfinite(P[k])):
             raise DataFileError(f"commanded joint angles {fmt_pose(np.degrees(meas.theta_cmd[k]))} deg are not an "
                                 "assembly of the robot (unreachable pose; angles in degrees?)", where=meas.where(k))

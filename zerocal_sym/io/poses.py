@@ -18,7 +18,7 @@ import numpy as np
 
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, _check_header, _check_pose_numbers, _json_line, _load_json,
-                                    _read_text, _rows_to_records, _split_csv, get_mechanism_of, infer_mechanism,
+                                    _read_text, _rows_to_array, _split_csv, get_mechanism_of, infer_mechanism,
                                     mechanism_for_shape, pose_columns)
 
 
@@ -91,10 +91,10 @@ def load_poses(path, robot=None) -> np.ndarray:
         _check_header(header, header_line, src, ("pose",) + cols, cols, example)
         if len(rows) == 1:
             raise DataFileError("no data rows after the header", where=f"{src}:{header_line}")
-        values, lines = _rows_to_records(rows[1:], header, src)
+        V, lines = _rows_to_array(rows[1:], header, src)
         if "pose" in header:
-            _check_pose_numbers(values, lines, src, header.index("pose") + 1)
-        P = np.array([[r[c] for c in cols] for r in values])
+            _check_pose_numbers(V[:, header.index("pose")], lines, src, header.index("pose") + 1)
+        P = V[:, [header.index(c) for c in cols]]
     if robot is not None:
         inside = robot.workspace.contains(P, 1e-6)
         for k in np.flatnonzero(~inside)[:1]:

@@ -1,0 +1,230 @@
+"""Checks of a command's options before it runs: what applies to the mode, numbers in range, outputs vs inputs.
+
+:func:`check_args` is called by :func:`zerocal_sym.cli.main` after parsing
+and before the command's ``run``, with the set of options the user gave
+explicitly (an option left at its default is not "given").  Every failure is
+a :class:`~zerocal_sym.errors.ZerocalError`: one line, exit status 2, nothing
+computed and nothing written.
+
+The rules:
+
+* **An option that does not apply to the chosen mode is an error**, not
+  ignored: ``design``'s optimisation settings without ``--optimize`` and the
+  boundary scheme's ``--n/--eps0/--maemm-prior`` with it; ``identify``'s
+  nlls-only options (``--params --prior-std --bound --max-iter``) with
+  ``--method tsvd`` and the tsvd-only ones (``--truncation --rule``) with
+  nlls; ``--truncation`` together with ``--rule`` (a fixed t has no rule);
+  ``compare``'s loop settings (``--mu0 --max-iter``) without a loop method;
+  ``compensate --max-offset-deg`` without a result; ``--report`` with
+  ``--json`` (the JSON holds the report); ``regen``/``study --robot``.
+* **Numbers**: seeds are integers >= 0; counts in their range (``--n`` at most
+  :data:`MAX_N` poses per boundary); thresholds finite and positive.
+* **Files**: no empty names; an output that is one of the command's inputs
+  (the same file however named) or another of its outputs is refused
+  (:func:`zerocal_sym.io.files.check_outputs`).
+"""
+from __future__ import annotations
+
+import math
+
+from zerocal_sym.errors import ZerocalError
+
+#: the most poses per boundary of a scheme (--n): K = 2n = 100,000 poses
+MAX_N = 50_000
+
+#: the files ``identify --plot DIR`` / ``verify --plot DIR`` / ``reproduce --out DIR`` write into DIR
+IDENTIFY_PLOTS = ("residuals.png", "boundary_errors.png")
+VERIFY_PLOTS = ("residuals.png",)
+REPRODUCE_FILES = (("fig8.png", "fig9.png", "results.json") + tuple(f"fig12_group{g}.png" for g in range(1, 7))
+                   + tuple(f"convergence_group{g}.png" for g in range(1, 7)))
+
+#: design options that belong to --optimize (dest names)
+DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
+                        "joint_limits", "min_separation", "noise", "starts", "workers", "scheduler")
+#: design options of the boundary scheme, not --optimize
+DESIGN_SCHEME_ONLY = ("n", "eps0", "maemm_prior")
+
+LOOP_METHODS = ("tsvd-loop", "nlls-loop", "nlls-seq")
+
+
+def _opt(dest: str) -> str:
+    return "--" + dest.replace("_", "-")
+
+
+def _opts(dests) -> str:
+    return ", ".join(_opt(d) for d in dests)
+
+
+def _given(args, *dests) -> list:
+    given = getattr(args, "_given", None)
+    if given is None:  # not through main(): what differs from None/False counts
+        return [d for d in dests if getattr(args, d, None) not in (None, False, [], ())]
+    return [d for d in dests if d in given]
+
+
+def _seed(args) -> None:
+    seed = getattr(args, "seed", None)
+    if seed is not None and seed < 0:
+        raise ZerocalError(f"--seed must be an integer >= 0 (it seeds numpy's random generator), got {seed}")
+
+
+def _n(args) -> None:
+    n = getattr(args, "n", None)
+    if n is not None and n > MAX_N:
+        raise ZerocalError(f"--n {n}: at most {MAX_N} poses per boundary (K = 2n = {2 * MAX_N} poses)")
+
+
+def _positive(args, dest, what, allow_zero=False) -> None:
+    v = getattr(args, dest, None)
+    if v is None:
+        return
+    ok = math.isfinite(v) and (v >= 0 if allow_zero else v > 0)
+    if not ok:
+        raise ZerocalError(f"{_opt(dest)} must be a finite {'non-negative' if allow_zero else 'positive'} "
+                           f"number{what}, got {v:g}")
+
+
+def _file_args(args, *pairs) -> None:
+    """``(label, value)``: a file name given as the empty string is an error."""
+    for label, v in pairs:
+        if v is not None and str(v) == "":
+            raise ZerocalError(f"{label}: empty file name")
+
+
+def _outputs(args, outputs, inputs) -> None:
+    from zerocal_sym.io.files import check_outputs
+
+    robot = getattr(args, "robot", None)
+    check_outputs(outputs, list(inputs) + [("the robot file", robot)])
+
+
+# --------------------------------------------------------------------------- per command
+
+def _identify(args) -> None:
+    if args.method == "tsvd":
+        bad = _given(args, "params", "prior_std", "bound", "max_iter")
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: for --method nlls only (tsvd identifies the zero offsets and the "
+                               "MAEMM, by the linearised model)")
+        if _given(args, "truncation") and _given(args, "rule"):
+            raise ZerocalError("--truncation fixes the truncation level: not with --rule (a rule chooses it)")
+        if args.rule == "discrepancy" and args.truncation is None and args.noise == "none":
+            raise ZerocalError("--rule discrepancy needs the noise level: not with --noise none (give --noise "
+                               "paper|scale-only|servo-only, or another --rule)")
+    else:
+        bad = _given(args, "truncation", "rule")
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: for --method tsvd only")
+        if args.max_iter is not None and args.max_iter < 1:
+            raise ZerocalError(f"--max-iter must be >= 1, got {args.max_iter}")
+    if args.report and args.json:
+        raise ZerocalError("--report is for the text output: the JSON (--json) holds the report under "
+                           "'identifiability'")
+    _file_args(args, ("DATA.csv", args.data))
+    _outputs(args, [("--out", args.out), ("--plot", args.plot, IDENTIFY_PLOTS)],
+             [("the measurement file", args.data)])
+
+
+def _compensate(args) -> None:
+    if args.result is None and _given(args, "max_offset_deg"):
+        raise ZerocalError("--max-offset-deg checks the offsets of RESULT.json: give the result (without one "
+                           "there is no offset to check)")
+    if args.max_offset_deg is not None:
+        _positive(args, "max_offset_deg", " of degrees")
+    _file_args(args, ("RESULT.json", args.result), ("--poses", args.poses))
+    _n(args)
+    _outputs(args, [("--out", args.out)], [("the results file", args.result), ("the pose file", args.poses)])
+
+
+def _verify(args) -> None:
+    _file_args(args, ("RESULT.json", args.result), ("DATA.csv", args.data))
+    _outputs(args, [("--out", args.out), ("--plot", args.plot, VERIFY_PLOTS)],
+             [("the results file", args.result), ("the measurement file", args.data)])
+
+
+def _simulate(args) -> None:
+    _seed(args)
+    _n(args)
+    _file_args(args, ("--poses", args.poses))
+    _outputs(args, [("--out", args.out)], [("the pose file", args.poses)])
+
+
+def _compare(args) -> None:
+    _seed(args)
+    _n(args)
+    methods = [m.strip() for m in str(args.methods).split(",") if m.strip()]
+    if not methods:
+        raise ZerocalError("--methods: no method given (a comma-separated subset of tsvd-loop, tsvd, nlls, "
+                           "nlls-loop, nlls-seq, scipy)")
+    loop = [m for m in methods if m in LOOP_METHODS]
+    bad = _given(args, "mu0", "max_iter")
+    if bad and not loop:
+        raise ZerocalError(f"{_opts(bad)}: for the loop methods ({', '.join(LOOP_METHODS)}) only; --methods "
+                           f"{','.join(methods)} has none")
+    if args.max_iter is not None and args.max_iter < 1:
+        raise ZerocalError(f"--max-iter must be >= 1 (identifications per loop), got {args.max_iter}")
+    _positive(args, "mu0", " of degrees")
+    poses = args.poses if args.poses not in ("paper", "ring") else None
+    _file_args(args, ("--poses", poses))
+    _outputs(args, [("--out", args.out)], [("the pose file", poses)])
+
+
+def _design(args) -> None:
+    if not args.optimize:
+        bad = _given(args, *DESIGN_OPTIMIZE_ONLY)
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: for --optimize only (the boundary scheme has no "
+                               f"{'such setting' if len(bad) == 1 else 'such settings'}); add --optimize")
+    else:
+        bad = _given(args, *DESIGN_SCHEME_ONLY)
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: for the boundary scheme (without --optimize); with --optimize "
+                               "--K sets the number of poses")
+        bad = [d for d in ("workers", "scheduler") if _given(args, d)]
+        if bad and not (getattr(args, "verify", 0) or 0):
+            raise ZerocalError(f"{_opts(bad)}: where the --verify Monte Carlo runs: give --verify N")
+    _seed(args)
+    _n(args)
+    outputs = [("--plot", getattr(args, "plot", None))]
+    if hasattr(args, "out"):
+        outputs.insert(0, ("--out", args.out))
+    _outputs(args, outputs, [])
+
+
+def _reproduce(args) -> None:
+    _seed(args)
+    _n(args)
+    if _given(args, "truncation") and _given(args, "rule"):
+        raise ZerocalError("--truncation fixes the truncation level: not with --rule (a rule chooses it)")
+    _outputs(args, [("--out", args.out, REPRODUCE_FILES)], [])
+
+
+def _regen(args) -> None:
+    if _given(args, "robot"):
+        raise ZerocalError("--robot: regen reads no robot file (it regenerates the code of every mechanism "
+                           "from derivations/)")
+    if args.out_dir is not None and args.out_dir == "":
+        raise ZerocalError("--out-dir: empty directory name")
+
+
+def _study(args) -> None:
+    if _given(args, "robot"):
+        raise ZerocalError("--robot: a study's robots are in its spec (robots = [...])")
+    _file_args(args, ("SPEC.toml", args.spec))
+    out = getattr(args, "out", None)
+    if out is not None:
+        _outputs(args, [("--out", out, ())], [("the study spec", args.spec)])
+
+
+CHECKS = {"identify": _identify, "compensate": _compensate, "verify": _verify, "simulate": _simulate,
+          "compare": _compare, "design": _design, "reproduce": _reproduce, "regen": _regen, "study": _study}
+
+
+def check_args(args) -> None:
+    """Check the options of ``args.command`` (module docstring); a ZerocalError names the option."""
+    robot = getattr(args, "robot", None)
+    if robot is not None and robot == "":
+        raise ZerocalError("--robot: empty file name")
+    check = CHECKS.get(getattr(args, "command", None))
+    if check is not None:
+        check(args)
