@@ -34,6 +34,22 @@ Criteria (all minimised internally as a log)
     ``sqrt(trace([F^-1]_offsets) / m)`` in degrees (minimised): the RMS
     Cramér-Rao bound of the m zero offsets under the full noise model,
     MAEMM as nuisance parameters.
+``position``
+    ``sqrt(tr(W [F_q^-1]_offsets))`` in mm (minimised): the RMS position
+    error over the robot's workspace grid after compensating with the
+    identified offsets, ``W = mean_x J_x^T J_x`` (``J_x`` the error Jacobian
+    ``kin.error_jacobian``, ``dP = J dq``); the worst grid point is reported
+    beside it (:func:`evaluate`).
+``mse``
+    ``sqrt(mean_i (CRLB_i^2 + E[b_i^2]))`` in degrees (minimised): the RMS
+    error of the m zero offsets including the first-order bias ``b`` from the
+    source errors the model leaves out, each uniform within its tolerance
+    (:mod:`zerocal_sym.identify.bias`; ``E[b_i^2] = sum_j S_ij^2 t_j^2 / 3``).
+    The bias does not shrink with K; the variance does.
+
+``position`` and ``mse`` take :class:`zerocal_sym.design.terms.Weights`
+(the position weight, the tolerances); ``mse`` works on the sensitivities
+with the omitted errors' columns appended (``Weights.extend``).
 """
 from __future__ import annotations
 
@@ -44,7 +60,7 @@ import numpy as np
 from zerocal_sym.errors import PoseError
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.constraints import Constraints, DesignError, check_design
-from zerocal_sym.design.terms import _crlb_weights, _qscale, design_params, pose_terms
+from zerocal_sym.design.terms import Weights, _crlb_weights, _qscale, design_params, pose_terms
 
 #: criterion name -> (description, units, better: "min" | "max"); p = m + n parameters
 #: (:func:`criteria_table` gives the table of one robot, with its names and p)
@@ -55,7 +71,12 @@ CRITERIA = {
     "A": ("trace of F_q^-1", "mm^2", "min"),
     "E": ("smallest eigenvalue of F_q", "1/mm^2", "max"),
     "crlb": ("RMS Cramer-Rao bound of the zero offsets (full noise model)", "deg", "min"),
+    "position": ("RMS position error over the workspace after compensation (offsets' CRLB through the error "
+                 "Jacobian)", "mm", "min"),
+    "mse": ("RMS zero-offset error: CRLB and the bias from the omitted errors' tolerances", "deg", "min"),
 }
+#: criteria that need the omitted errors' sensitivities (``Weights.extend``)
+EXTENDED = ("mse",)
 
 
 def criteria_table(robot) -> dict:
@@ -115,27 +136,79 @@ def _fisher_batch(aq, v, sm2):
     return (F + np.swapaxes(F, 1, 2)) / 2
 
 
+def _fisher_banded(aq, v, sm2):
+    """:func:`_fisher_batch` of one long ordered design by a banded solve, O(K), shape (p, p).
+
+    ``aq`` (K, p), ``v`` (K,).
+    """
+    from scipy.linalg import solveh_banded
+
+    A = np.diff(aq, axis=0)
+    K = aq.shape[0]
+    ab = np.zeros((2, K - 1))
+    ab[1] = sm2 + v[:-1] + v[1:]
+    ab[0, 1:] = -v[1:-1]
+    X = solveh_banded(ab, A)
+    F = A.T @ X
+    return (F + F.T) / 2
+
+
+#: from this K on, one design's Fisher information is computed by a banded solve (smaller K: dense, as before)
+BANDED_K = 60
+
+
+def _fisher(aq, v, sm2):
+    """:func:`_fisher_batch`, banded for one design with K >= :data:`BANDED_K`."""
+    if aq.shape[0] == 1 and aq.shape[1] >= BANDED_K:
+        return _fisher_banded(aq[0], v[0], sm2)[None]
+    return _fisher_batch(aq, v, sm2)
+
+
 def _objective_batch(criterion, aq, v, sm2, w):
     """Internal objective (smaller is better; ``inf`` for rank-deficient designs), shape (B,).
 
     Parameters
     ----------
-    aq : ndarray, shape (B, K, p)
+    aq : ndarray, shape (B, K, p) or (B, K, p + r)
+        Per-pose sensitivities in q-units; for ``mse`` with the omitted
+        errors' columns appended (:meth:`Weights.extend`).
     v : ndarray, shape (B, K)
     sm2 : float
-    w : ndarray, shape (p,)
+    w : ndarray, shape (p,), or Weights
         Weights of the crlb criterion (:func:`zerocal_sym.design.terms._crlb_weights`):
         its objective is ``log sum_j w_j [F_q^-1]_jj``, the log of the mean
-        variance of the zero offsets (rad^2).
+        variance of the zero offsets (rad^2); a :class:`Weights` for every
+        criterion (``position`` and ``mse`` need one).
     """
     B = aq.shape[0]
     out = np.full(B, np.inf)
     if criterion == "cond":
-        s = np.linalg.svd(np.diff(aq, axis=1), compute_uv=False)
+        p = w.p if isinstance(w, Weights) else len(w)
+        s = np.linalg.svd(np.diff(aq[..., :p], axis=1), compute_uv=False)
         ok = s[:, -1] > 1e-12 * s[:, 0]
         out[ok] = np.log(s[ok, 0] / s[ok, -1])
         return out
-    F = _fisher_batch(aq, v, sm2)
+    return _objective_fisher(criterion, _fisher(aq, v, sm2), w)
+
+
+def _objective_fisher(criterion, F, w):
+    """Internal objective from Fisher informations (q-units), shape (B,).
+
+    ``F`` : (B, p, p), or (B, p + r, p + r) for ``mse`` (the omitted errors'
+    block scaled by their RMS tolerances: ``H = F[:p, p:]`` gives the bias
+    ``F_pp^-1 H``).
+    """
+    B = F.shape[0]
+    out = np.full(B, np.inf)
+    wt = w if isinstance(w, Weights) else None
+    wc = wt.crlb if wt is not None else np.asarray(w, float)
+    p = len(wc)
+    if criterion in ("position", "mse") and wt is None:
+        raise DesignError(f"criterion {criterion!r} needs design weights (design.terms.Weights)")
+    H = None
+    if criterion == "mse":
+        H = F[:, :p, p:]
+    F = F[:, :p, :p]
     ev = np.linalg.eigvalsh(F)
     ok = ev[:, 0] > 1e-12 * np.maximum(ev[:, -1], 1e-300)
     if not np.any(ok):
@@ -150,33 +223,45 @@ def _objective_batch(criterion, aq, v, sm2, w):
         if criterion == "A":
             out[ok] = np.log(np.trace(Finv, axis1=1, axis2=2))
         elif criterion == "crlb":
-            out[ok] = np.log(np.diagonal(Finv, axis1=1, axis2=2) @ np.asarray(w, float))
+            out[ok] = np.log(np.diagonal(Finv, axis1=1, axis2=2) @ wc)
+        elif criterion == "position":
+            out[ok] = np.log(np.einsum("ij,bji->b", wt.position, Finv))
+        elif criterion == "mse":
+            Bm = Finv @ H[ok]
+            out[ok] = np.log((np.diagonal(Finv, axis1=1, axis2=2) + np.sum(Bm ** 2, axis=2)) @ wc)
         else:
             raise DesignError(f"unknown criterion {criterion!r}")
     return out
 
 
-def criterion_values(robot, P, noise: NoiseModel | None = None) -> dict:
+def criterion_values(robot, P, noise: NoiseModel | None = None, tolerances=None) -> dict:
     """Every criterion of an ordered design, in the user's units.
 
     Parameters
     ----------
     P : ndarray, shape (K, n)
         Poses in visiting order, mm.
+    tolerances : dict name -> value (internal units), optional
+        Tolerances of the omitted errors for ``mse`` (default
+        :func:`zerocal_sym.identify.bias.default_tolerances`).
 
     Returns
     -------
     dict
         ``cond`` (-), ``D`` (log det F_q), ``A`` (mm^2), ``E`` (1/mm^2),
-        ``crlb`` (deg, RMS over the m offsets); ``inf``/``-inf`` where the
-        design is rank-deficient.
+        ``crlb`` (deg, RMS over the m offsets), ``position`` (mm), ``mse``
+        (deg); ``inf``/``-inf`` where the design is rank-deficient.
     """
     sm2, _ = _noise_terms(noise)
     w = _crlb_weights(robot)
-    aq, v = _terms_batch(robot, P, noise)
+    wt = Weights(robot, tolerances)
+    aq, v, ao = _terms_batch(robot, P, noise, omitted=True)
     res = {}
     for c in CRITERIA:
-        o = float(_objective_batch(c, aq, v, sm2, w)[0])
+        if c in EXTENDED:
+            o = float(_objective_batch(c, wt.extend(aq, ao), v, sm2, wt)[0])
+        else:
+            o = float(_objective_batch(c, aq, v, sm2, wt if c == "position" else w)[0])
         res[c] = _user_value(c, o)
     return res
 
@@ -184,7 +269,10 @@ def criterion_values(robot, P, noise: NoiseModel | None = None) -> dict:
 def _user_value(criterion, obj):
     """Internal objective -> user-facing value."""
     if not np.isfinite(obj):
-        return {"cond": math.inf, "D": -math.inf, "A": math.inf, "E": 0.0, "crlb": math.inf}[criterion]
+        return {"cond": math.inf, "D": -math.inf, "A": math.inf, "E": 0.0, "crlb": math.inf,
+                "position": math.inf, "mse": math.inf}[criterion]
+    if criterion == "position":
+        return math.sqrt(math.exp(obj))
     if criterion == "cond":
         return math.exp(obj)
     if criterion == "D":
@@ -198,32 +286,44 @@ def _user_value(criterion, obj):
 
 # --------------------------------------------------------------------------- evaluation
 def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
-             cons: Constraints | None = None) -> dict:
+             cons: Constraints | None = None, tolerances=None) -> dict:
     """Report of one ordered design.
+
+    Parameters
+    ----------
+    tolerances : dict name -> value (internal units), optional
+        Tolerances of the omitted errors (``mse`` and the ``bias`` entry;
+        default :func:`zerocal_sym.identify.bias.default_tolerances`).
 
     Returns
     -------
     dict
         ``poses`` (K x n mm), ``joints_deg`` (K x m), ``pose_names``,
         ``joint_names``, ``criterion`` {``name``, ``value``, ``units``,
-        ``values`` (all five), ``units_all``}, ``crlb_zero_offsets_deg`` (m,)
+        ``values`` (all seven), ``units_all``}, ``crlb_zero_offsets_deg`` (m,)
         from :func:`zerocal_sym.identify.fisher.crlb_zero_offsets_deg` and
-        its RMS ``crlb_rms_deg``, ``kappa`` (the paper's kappa_1 of G, no
+        its RMS ``crlb_rms_deg``, ``bias`` (worst-case and RMS bias of the
+        zero offsets from the tolerances, :func:`zerocal_sym.identify.bias.tolerance_bias`,
+        and the RMS error ``sqrt(CRLB^2 + RMS bias^2)`` per offset),
+        ``position`` (RMS and worst position error over the workspace grid
+        after compensation, mm), ``kappa`` (the paper's kappa_1 of G, no
         MAEMM prior), ``rho_span_mm``, ``min_transmission_sine`` and, with
         ``cons``, ``violations``.
     """
-    from zerocal_sym.identify import fisher
+    from zerocal_sym.identify import bias, fisher
     from zerocal_sym.identify.linear import condition_number, identification_matrix
 
     P = np.atleast_2d(np.asarray(P, float))
     noise = noise or NoiseModel.paper()
     table = criteria_table(robot)
-    vals = criterion_values(robot, P, noise)
+    vals = criterion_values(robot, P, noise, tolerances)
     t = pose_terms(robot, P)
     try:
         crlb = fisher.crlb_zero_offsets_deg(robot, t["theta"], "paper", noise).tolist()
     except PoseError:
         crlb = [math.inf] * robot.m
+    bias_rep = _bias_report(robot, t["theta"], noise, tolerances, crlb)
+    pos = position_report(robot, P, noise)
     G, _ = identification_matrix(robot, P, theta=t["theta"])
     rep = {
         "poses": P.tolist(),
@@ -234,6 +334,8 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
                       "values": vals, "units_all": {c: table[c][1] for c in table}},
         "crlb_zero_offsets_deg": crlb,
         "crlb_rms_deg": float(np.sqrt(np.mean(np.square(crlb)))),
+        "bias": bias_rep,
+        "position": pos,
         "kappa": condition_number(G),
         "rho_span_mm": float(np.ptp(t["rho"])),
         "min_transmission_sine": float(np.min(np.abs(t["s"]))),
@@ -243,17 +345,92 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     return rep
 
 
+def _bias_report(robot, theta, noise, tolerances, crlb):
+    """The zero offsets' bias from the tolerances (deg) and the RMS error with the CRLB."""
+    from zerocal_sym.identify import bias
+
+    try:
+        b = bias.tolerance_bias(robot, theta, tolerances, "paper", noise)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    z = b["zero_offsets"]
+    rms_err = np.sqrt(np.square(crlb) + np.square(z["rms_deg"]))
+    return {"worst_case_deg": z["worst_case_deg"], "rms_deg": z["rms_deg"],
+            "worst_case_rms_deg": float(np.sqrt(np.mean(np.square(z["worst_case_deg"])))),
+            "rms_rms_deg": float(np.sqrt(np.mean(np.square(z["rms_deg"])))),
+            "rms_error_deg": rms_err.tolist(), "rms_error_rms_deg": float(np.sqrt(np.mean(rms_err ** 2))),
+            "tolerances": b["tolerances"], "tolerance_units": b["tolerance_units"], "model": b["model"]}
+
+
+def position_report(robot, P, noise=None) -> dict:
+    """Predicted position error over the workspace after compensating with offsets identified from ``P``.
+
+    The offsets' covariance (CRLB, q-units) propagated through the error
+    Jacobian at each point of the workspace grid
+    (:func:`zerocal_sym.design.terms.position_grid`): ``sqrt(tr(J Sigma J^T))``
+    per point (mm, the RMS length of the position error there).
+
+    Returns
+    -------
+    dict
+        ``rms_mm`` (over the grid), ``max_mm`` (worst grid point),
+        ``worst_pose`` (n,), ``grid_points``.
+    """
+    from zerocal_sym.design.terms import offset_positions, position_jacobians
+
+    P = np.atleast_2d(np.asarray(P, float))
+    sm2, _ = _noise_terms(noise)
+    aq, v = _terms_batch(robot, P, noise)
+    F = _fisher(aq, v, sm2)[0]
+    grid, J = position_jacobians(robot)
+    try:
+        Fi = np.linalg.inv(F)
+    except np.linalg.LinAlgError:
+        return {"rms_mm": math.inf, "max_mm": math.inf, "worst_pose": None, "grid_points": len(grid)}
+    off = offset_positions(robot)
+    S = Fi[np.ix_(off, off)]
+    e2 = np.einsum("gni,ij,gnj->g", J, S, J)
+    if not np.all(np.isfinite(e2)) or np.any(e2 < 0):
+        return {"rms_mm": math.inf, "max_mm": math.inf, "worst_pose": None, "grid_points": len(grid)}
+    k = int(np.argmax(e2))
+    return {"rms_mm": float(np.sqrt(np.mean(e2))), "max_mm": float(np.sqrt(e2[k])), "worst_pose": grid[k].tolist(),
+            "grid_points": len(grid)}
+
+
 def _check_criterion(criterion):
     if criterion not in CRITERIA:
         raise DesignError(f"unknown criterion {criterion!r} (known: {', '.join(CRITERIA)})")
 
 
-def _terms_batch(robot, P, noise):
+def _terms_batch(robot, P, noise, omitted=False):
+    """``aq`` (1, K, p), ``v`` (1, K) [, ``ao`` (1, K, r) with ``omitted``]."""
     _, sx2 = _noise_terms(noise)
     t = pose_terms(robot, P)
-    return (t["a"] * _qscale(robot))[None], (sx2 * np.sum(t["dth"] ** 2, axis=1))[None]
+    out = (t["a"] * _qscale(robot))[None], (sx2 * np.sum(t["dth"] ** 2, axis=1))[None]
+    return out + (t["ao"][None],) if omitted else out
 
 
-def _objective(robot, criterion, P, noise):
+def _criterion_terms(robot, criterion, t, qs, sx2, wt):
+    """Per-pose ``aq`` (K, p or p + r) and ``v`` (K,) of a criterion from :func:`pose_terms` output."""
+    aq = t["a"] * qs
+    if criterion in EXTENDED:
+        aq = wt.extend(aq, t["ao"])
+    return aq, sx2 * np.sum(t["dth"] ** 2, axis=1)
+
+
+def _criterion_weights(robot, criterion, tolerances=None):
+    """The ``w`` argument of :func:`_objective_batch` for a criterion: the crlb weights, or :class:`Weights`."""
+    if criterion in ("position",) + EXTENDED:
+        return Weights(robot, tolerances)
+    return _crlb_weights(robot)
+
+
+def _objective(robot, criterion, P, noise, tolerances=None):
+    if criterion in ("position",) + EXTENDED:
+        wt = Weights(robot, tolerances)
+        aq, v, ao = _terms_batch(robot, P, noise, omitted=True)
+        if criterion in EXTENDED:
+            aq = wt.extend(aq, ao)
+        return float(_objective_batch(criterion, aq, v, _noise_terms(noise)[0], wt)[0])
     return float(_objective_batch(criterion, *_terms_batch(robot, P, noise), _noise_terms(noise)[0],
                                   _crlb_weights(robot))[0])

@@ -12,8 +12,9 @@ import numpy as np
 
 from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, _feasible_random_subset,
                                             _pointwise_ok, make_constraints)
-from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective_batch, _user_value
-from zerocal_sym.design.terms import _crlb_weights, _qscale, pose_terms
+from zerocal_sym.design.criteria import (_check_criterion, _criterion_terms, _criterion_weights, _noise_terms,
+                                         _objective_batch, _user_value)
+from zerocal_sym.design.terms import _qscale, pose_terms
 
 
 # --------------------------------------------------------------------------- discrete exchange
@@ -29,7 +30,7 @@ def candidate_grid(robot, cons: Constraints, *grid):
 
 
 def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                    n_starts: int = 8, grid=None, max_sweeps: int = 50):
+                    n_starts: int = 8, grid=None, max_sweeps: int = 50, tolerances=None):
     """Discrete coordinate exchange over a candidate grid.
 
     Each start is a random ordered set of K distinct feasible candidates
@@ -43,6 +44,8 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         Candidate grid (:func:`candidate_grid`); default the region's
         (25 x 11 on a rectangle, 4 rings / 24 on the rim / 5 levels on a
         cylinder).
+    tolerances : dict, optional
+        Tolerances of the omitted errors (``mse``).
 
     Returns
     -------
@@ -62,10 +65,9 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
                           "margin or joint limits, or enlarge the region")
     sm2, sx2 = _noise_terms(noise)
     qs = _qscale(robot)
-    wc = _crlb_weights(robot)
+    wc = _criterion_weights(robot, criterion, tolerances)
     t = pose_terms(robot, cand)
-    aq_all = t["a"] * qs
-    v_all = sx2 * np.sum(t["dth"] ** 2, axis=1)
+    aq_all, v_all = _criterion_terms(robot, criterion, t, qs, sx2, wc)
     rho = t["rho"]
     rng = np.random.default_rng(seed)
     N = len(cand)

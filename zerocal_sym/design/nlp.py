@@ -40,9 +40,9 @@ import numpy as np
 
 from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, _feasible_random_subset,
                                             _pointwise_ok, check_design, make_constraints)
-from zerocal_sym.design.criteria import (_check_criterion, _fisher_batch, _noise_terms, _objective_batch,
-                                         _terms_batch, _user_value)
-from zerocal_sym.design.terms import _crlb_weights, _pose_terms_fn, _qscale, pose_terms
+from zerocal_sym.design.criteria import (EXTENDED, _check_criterion, _criterion_weights, _fisher_batch,
+                                         _noise_terms, _objective, _objective_batch, _terms_batch, _user_value)
+from zerocal_sym.design.terms import Weights, _crlb_weights, _pose_terms_fn, _qscale, pose_terms
 
 #: formulation of the matrix inequalities per criterion for p <= 4 (measured best, see module docstring)
 PSD_FORM = {"E": "minors", "cond": "chol"}
@@ -72,13 +72,14 @@ class _NLP:
     """The symbolic design NLP for one (robot, K, criterion, constraints, noise)."""
 
     def __init__(self, robot, K, criterion, cons: Constraints, noise, fscale, mscale, max_iter=500,
-                 psd_form=None, ipopt_options=None):
+                 psd_form=None, ipopt_options=None, tolerances=None):
         import casadi as ca
 
         self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
         sm2, sx2 = _noise_terms(noise)
         qs = _qscale(robot)
         wc = _crlb_weights(robot)
+        wts = Weights(robot, tolerances) if criterion in ("position",) + EXTENDED else None
         dim, p = robot.n, len(qs)  # pose coordinates, parameters
         psd_form = psd_form or _psd_form(criterion, p)
         self.n = dim
@@ -87,7 +88,7 @@ class _NLP:
         z = ca.SX.sym("z", dim, K)
         P = ca.repmat(ca.DM(c), 1, K) + ca.repmat(ca.DM(h), 1, K) * z
         f = _pose_terms_fn(robot.mechanism_name).map(K)
-        theta, ratio, s, rho, a, dth = f(P, robot.geometry)
+        theta, ratio, s, rho, a, dth, ao = f(P, robot.geometry)
         aq = ca.repmat(ca.DM(qs), 1, K) * a
         v = sx2 * ca.sum1(dth ** 2)
         g, lbg, ubg = [], [], []
@@ -159,11 +160,19 @@ class _NLP:
             e = [-v[i + 1] for i in range(K - 2)]
             Dp, w = d[0], b[0]
             F = w @ w.T / Dp
+            if criterion in EXTENDED:  # cross information with the omitted errors (scaled by t / sqrt(3))
+                aoq = ca.repmat(ca.DM(wts.tol), 1, K) * ao
+                bo = [aoq[:, i + 1] - aoq[:, i] for i in range(K - 1)]
+                wo = bo[0]
+                Hx = w @ wo.T / Dp
             for i in range(1, K - 1):
                 m = e[i - 1] / Dp
                 Dp = d[i] - m * e[i - 1]
                 w = b[i] - m * w
                 F = F + w @ w.T / Dp
+                if criterion in EXTENDED:
+                    wo = bo[i] - m * wo
+                    Hx = Hx + w @ wo.T / Dp
             Fn = F / fscale
             if criterion == "D":
                 obj = -ca.log(ca.det(Fn))
@@ -176,6 +185,14 @@ class _NLP:
                 Finv = ca.inv(Fn)
                 if criterion == "A":
                     obj = ca.log(ca.trace(Finv))
+                elif criterion == "position":
+                    Wp = wts.position
+                    obj = ca.log(sum(float(Wp[i, j]) * Finv[j, i] for i in range(p) for j in range(p)
+                                     if Wp[i, j] != 0))
+                elif criterion in EXTENDED:  # variance + squared bias; Finv = fscale F^-1, bias = F^-1 H
+                    Bm = Finv @ (Hx / fscale)
+                    obj = ca.log(sum(float(wc[j]) * (Finv[j, j] + fscale * ca.sumsqr(Bm[j, :]))
+                                     for j in range(p) if wc[j] != 0))
                 else:
                     obj = ca.log(sum(float(wc[j]) * Finv[j, j] for j in range(p) if wc[j] != 0))
         self.aux = aux
@@ -255,7 +272,7 @@ def _scales(robot, P, noise):
 
 
 def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                      n_starts: int = 8, starts=None, max_iter: int = 500):
+                      n_starts: int = 8, starts=None, max_iter: int = 500, tolerances=None):
     """Multi-start Ipopt over the K poses.
 
     Parameters
@@ -272,6 +289,8 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         Number of random starts.
     starts : list of (label, ndarray shape (K, n)), optional
         Extra starts (e.g. the boundary scheme, an exchange design).
+    tolerances : dict, optional
+        Tolerances of the omitted errors (``mse``).
 
     Returns
     -------
@@ -295,16 +314,14 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
     ref = next((P for _, P in all_starts if np.isfinite(_objective_batch(
         "D", *_terms_batch(robot, P, noise), _noise_terms(noise)[0], _crlb_weights(robot))[0])), all_starts[0][1])
     fscale, mscale = _scales(robot, ref, noise)
-    nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter)
+    nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter, tolerances=tolerances)
     build_s = time.perf_counter() - t0
     best, runs = None, []
-    sm2 = _noise_terms(noise)[0]
-    wc = _crlb_weights(robot)
     for label, P0 in all_starts:
         ts = time.perf_counter()
         P, status, iters = nlp.solve(P0)
         viol = check_design(robot, P, cons)
-        o = float(_objective_batch(criterion, *_terms_batch(robot, P, noise), sm2, wc)[0])
+        o = _objective(robot, criterion, P, noise, tolerances)
         runs.append({"start": label, "value": _user_value(criterion, o), "status": status, "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
         if not viol and np.isfinite(o) and (best is None or o < best[1]):

@@ -157,7 +157,7 @@ def _ratio(a, b):
 
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
-                    exchange_starts: int = 8, grid=None, reorder: bool = True) -> DesignResult:
+                    exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None) -> DesignResult:
     """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
     Stages: discrete exchange (``exchange_starts`` seeded starts over the
@@ -194,13 +194,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     cons = cons or make_constraints(robot)
     timing = {}
     t0 = time.perf_counter()
-    ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid)
+    ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances)
     timing["exchange"] = time.perf_counter() - t0
     base = paper_baseline(robot, K, cons.region)
     scheme = robot.workspace.scheme_name
     starts = [(f"{scheme} scheme", base)] if not check_design(robot, base, cons) else []
     t1 = time.perf_counter()
-    cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts)
+    cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances)
     timing["continuous"] = time.perf_counter() - t1
     nlp = cont.pop("nlp")
     cands = [("continuous", cont["poses"], cont["objective"]), ("exchange", ex["poses"], ex["objective"])]
@@ -208,22 +208,22 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     polished = []
     for label, P, o in cands:
         if reorder:
-            order, _ = best_order(robot, P, criterion, noise, cons)
+            order, _ = best_order(robot, P, criterion, noise, cons, tolerances=tolerances)
             if np.any(order != np.arange(K)):
                 P = P[order]
                 label = label + " +order"
         Pp, status, _ = nlp.solve(P)
-        op = _objective(robot, criterion, Pp, noise)
-        if not check_design(robot, Pp, cons) and op <= _objective(robot, criterion, P, noise):
+        op = _objective(robot, criterion, Pp, noise, tolerances)
+        if not check_design(robot, Pp, cons) and op <= _objective(robot, criterion, P, noise, tolerances):
             polished.append((label + " +ipopt", Pp, op))
         else:
-            polished.append((label, P, _objective(robot, criterion, P, noise)))
+            polished.append((label, P, _objective(robot, criterion, P, noise, tolerances)))
     timing["order_polish"] = time.perf_counter() - t2
     polished = [c for c in polished if not check_design(robot, c[1], cons)]
     if not polished:
         raise DesignError("neither method produced a design that meets the constraints")
     label, P, _ = min(polished, key=lambda c: c[2])
     timing["total"] = time.perf_counter() - t0
-    return DesignResult(poses=P, criterion=criterion, report=evaluate(robot, P, criterion, noise, cons),
-                        paper=evaluate(robot, base, criterion, noise, cons), constraints=cons, exchange=ex,
+    return DesignResult(poses=P, criterion=criterion, report=evaluate(robot, P, criterion, noise, cons, tolerances),
+                        paper=evaluate(robot, base, criterion, noise, cons, tolerances), constraints=cons, exchange=ex,
                         continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme)

@@ -13,18 +13,13 @@ import itertools
 import numpy as np
 
 from zerocal_sym.design.constraints import Constraints
-from zerocal_sym.design.criteria import _noise_terms, _objective_batch
-from zerocal_sym.design.terms import _crlb_weights, _qscale, pose_terms
+from zerocal_sym.design.criteria import _criterion_terms, _criterion_weights, _noise_terms, _objective_batch
+from zerocal_sym.design.terms import _qscale, pose_terms
 
 
 # --------------------------------------------------------------------------- ordering
-def _permute_terms(t, perms, qs, sx2):
-    aq = (t["a"] * qs)[perms]
-    v = (sx2 * np.sum(t["dth"] ** 2, axis=1))[perms]
-    return aq, v
-
-
-def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None, exhaustive_max: int = 8):
+def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None, exhaustive_max: int = 8,
+               tolerances=None):
     """Visiting order of the poses that minimises the criterion.
 
     Exhaustive over all K! orders for ``K <= exhaustive_max``; otherwise a
@@ -42,13 +37,13 @@ def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None,
     K = len(P)
     sm2, sx2 = _noise_terms(noise)
     qs = _qscale(robot)
-    wc = _crlb_weights(robot)
+    wc = _criterion_weights(robot, criterion, tolerances)
     t = pose_terms(robot, P)
     rho = t["rho"]
+    aq0, v0 = _criterion_terms(robot, criterion, t, qs, sx2, wc)
 
     def objective(perms):
-        aq, v = _permute_terms(t, perms, qs, sx2)
-        o = _objective_batch(criterion, aq, v, sm2, wc)
+        o = _objective_batch(criterion, aq0[perms], v0[perms], sm2, wc)
         if cons is not None and cons.travel_mode == "consecutive":
             o[np.max(np.abs(np.diff(rho[perms], axis=1)), axis=1) > cons.travel_mm] = np.inf
         return o

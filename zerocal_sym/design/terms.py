@@ -34,6 +34,12 @@ def design_params(robot) -> tuple:
     return robot.errors.resolve("paper")
 
 
+def omitted_params(robot) -> tuple:
+    """The source errors the design model leaves out (held at zero by the identification), shape (r,)."""
+    keep = set(design_params(robot))
+    return tuple(n for n in robot.errors.names if n not in keep)
+
+
 def offset_positions(robot) -> list:
     """Positions of the zero offsets among :func:`design_params`, shape (m,)."""
     names = design_params(robot)
@@ -43,11 +49,13 @@ def offset_positions(robot) -> list:
 # --------------------------------------------------------------------------- per-pose terms
 @lru_cache(maxsize=None)
 def _pose_terms_fn(mech_name: str):
-    """CasADi Function (P[n], g[G]) -> theta[m], ratio[m], s[s], rho, a[p], dth[m].
+    """CasADi Function (P[n], g[G]) -> theta[m], ratio[m], s[s], rho, a[p], dth[m], ao[r].
 
     ``a = d rho / d (zero offsets, MAEMM)`` (per rad, per mm; the paper's
-    parameter set, p = m + n) and ``dth = d rho / d theta`` (per rad), exact
-    derivatives at zero source errors, joints from the inverse kinematics.
+    parameter set, p = m + n), ``dth = d rho / d theta`` (per rad) and
+    ``ao = d rho / d (omitted errors)`` (the r source errors not in the
+    paper's set, :func:`omitted_params`), exact derivatives at zero source
+    errors, joints from the inverse kinematics.
     """
     import casadi as ca
 
@@ -69,8 +77,9 @@ def _pose_terms_fn(mech_name: str):
     sub = ca.Function("drho", [th, g, err], [rho, de, dt])
     r, de_v, dt_v = sub(theta, g, ca.DM.zeros(ne))
     a = ca.vertcat(*[de_v[0, i] for i in idx])
-    return ca.Function("design_pose_terms", [P, g], [theta, ratio, s, r, a, dt_v.T],
-                       ["P", "g"], ["theta", "ratio", "s", "rho", "a", "dth"])
+    ao = ca.vertcat(*[de_v[0, i] for i in range(ne) if i not in idx])
+    return ca.Function("design_pose_terms", [P, g], [theta, ratio, s, r, a, dt_v.T, ao],
+                       ["P", "g"], ["theta", "ratio", "s", "rho", "a", "dth", "ao"])
 
 
 def pose_terms(robot, P) -> dict:
@@ -87,13 +96,13 @@ def pose_terms(robot, P) -> dict:
         ``theta`` (K, m) rad, ``ratio`` (K, m), ``s`` (K, s) singularity
         indicators, ``rho`` (K,) mm, ``a`` (K, p) d rho / d p (per rad, per
         mm; p = m + n, :func:`design_params`), ``dth`` (K, m) d rho / d theta
-        (mm/rad).
+        (mm/rad), ``ao`` (K, r) d rho / d (omitted errors) (:func:`omitted_params`).
     """
     P = np.atleast_2d(np.asarray(P, float))
     K = len(P)
     f = _pose_terms_fn(robot.mechanism_name)
     out = f(P.T, robot.geometry)
-    names = ("theta", "ratio", "s", "rho", "a", "dth")
+    names = ("theta", "ratio", "s", "rho", "a", "dth", "ao")
     res = {nm: o.full().T.reshape(K, -1) for nm, o in zip(names, out)}
     res["rho"] = res["rho"][:, 0]
     return res
@@ -118,3 +127,84 @@ def _crlb_weights(robot):
     off = offset_positions(robot)
     w[off] = qs[off] ** 2 / len(off)
     return w
+
+
+# --------------------------------------------------------------------------- position and bias weights
+_POSITION_CACHE: dict = {}
+
+
+def position_grid(robot) -> np.ndarray:
+    """Where the position criterion averages: the robot's workspace grid (``robot.workspace_grid()``), shape (G, n).
+
+    A rectangle: 25 x 9 points; a cylinder: the axis and 4 rings of 24 points on 5 levels.
+    """
+    return np.asarray(robot.workspace_grid(), float)
+
+
+def position_jacobians(robot):
+    """Error Jacobians ``dP = J dq`` (q = lever-arm arcs of the zero offsets, mm) over :func:`position_grid`.
+
+    Returns
+    -------
+    grid : ndarray, shape (G, n)
+    J : ndarray, shape (G, n, m)
+    """
+    from zerocal_sym.model import kinematics as kin
+
+    key = robot.sha256
+    if key not in _POSITION_CACHE:
+        grid = position_grid(robot)
+        _POSITION_CACHE[key] = (grid, kin.error_jacobian(robot, grid))
+    return _POSITION_CACHE[key]
+
+
+def _position_weight(robot):
+    """``W`` of the position criterion, shape (p, p): ``mean_x J_x^T J_x`` on the zero offsets' block (q-units).
+
+    The mean squared position error over the grid after compensating with
+    offsets of covariance ``Sigma`` (q-units) is ``tr(W Sigma)``.
+    """
+    _, J = position_jacobians(robot)
+    names = design_params(robot)
+    p = len(names)
+    off = offset_positions(robot)
+    W = np.zeros((p, p))
+    W[np.ix_(off, off)] = np.einsum("gni,gnj->ij", J, J) / len(J)
+    return W
+
+
+def _tolerance_columns(robot, tolerances):
+    """Scale of the omitted-error sensitivities for the bias: ``t_j / sqrt(3)`` (RMS of a uniform error), shape (r,).
+
+    ``tolerances``: dict name -> value (internal units) or None for the defaults
+    (:func:`zerocal_sym.identify.bias.default_tolerances`).
+    """
+    from zerocal_sym.identify import bias
+
+    tol = bias.default_tolerances(robot) if tolerances is None else tolerances
+    return bias.tolerance_vector(robot, tol, omitted_params(robot)) / np.sqrt(3.0)
+
+
+class Weights:
+    """What the criteria need besides the Fisher information, for one robot.
+
+    Attributes
+    ----------
+    crlb : ndarray, shape (p,)
+        :func:`_crlb_weights`.
+    position : ndarray, shape (p, p)
+        :func:`_position_weight`.
+    tol : ndarray, shape (r,)
+        RMS of each omitted error (``t / sqrt(3)``), internal units.
+    p, r : int
+    """
+
+    def __init__(self, robot, tolerances=None):
+        self.crlb = _crlb_weights(robot)
+        self.position = _position_weight(robot)
+        self.tol = _tolerance_columns(robot, tolerances)
+        self.p, self.r = len(self.crlb), len(self.tol)
+
+    def extend(self, aq, ao):
+        """Sensitivities with the omitted errors' columns appended (``ao * t / sqrt(3)``), shape (..., p + r)."""
+        return np.concatenate([aq, ao * self.tol], axis=-1)

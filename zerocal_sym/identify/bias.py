@@ -1,0 +1,243 @@
+"""Bias from the source errors an identification leaves out, for given tolerances.
+
+The identification estimates a parameter set (default the paper's: the zero
+offsets and the MAEMM) and holds every other source error at zero.  If those
+*omitted* errors are not zero the estimate is biased; to first order
+(:func:`zerocal_sym.identify.fisher.model_bias`)::
+
+    b = S e_o,     S = (A^T C^-1 A)^-1 A^T C^-1 A_o          (p x r)
+
+with ``A``, ``A_o`` the sensitivities of the K-1 measured changes to the
+identified and to the omitted errors and ``C`` the covariance of the changes
+(the weighting of the estimator).  :func:`bias_sensitivity` gives ``S``.
+
+Tolerances
+----------
+A tolerance ``t_j`` bounds an omitted error: ``|e_j| <= t_j``.  Then, per
+identified parameter ``i`` (model: first order, the errors independent)
+
+* worst case ``sum_j |S_ij| t_j`` (the largest bias any errors within the
+  tolerances give);
+* RMS ``sqrt(sum_j S_ij^2 t_j^2 / 3)``: the root mean square bias when each
+  ``e_j`` is uniform on ``[-t_j, t_j]`` (variance ``t_j^2 / 3``).
+
+Defaults (:func:`default_tolerances`): for the paper's planar robot the
+magnitudes of Table 2's geometric error set A (``e1x`` 0.03 mm, ``e1y`` 0.02,
+``e2x`` 0.02, ``e2y`` 0.01, ``L1`` 0.01, ``L2`` 0.02, ``l1`` 0.03, ``l2`` 0.02
+mm) as an example of a machining tolerance; for any other mechanism
+:data:`DEFAULT_LENGTH_TOLERANCE_MM` per length and
+:data:`DEFAULT_ANGLE_TOLERANCE_DEG` per angle.  Tolerances are given in user
+units (mm, deg) by name: ``NAME=VALUE`` items, a TOML or JSON file of
+``name = value``, and a scale factor (``10`` for ten times set A).
+
+The MAEMM (identified) and the gauge: the omitted errors include the ones
+that fix the mechanism's gauge (planar ``e1x e1y e2y``); part of their effect
+is absorbed by the MAEMM estimate, which is what the first-order formula
+gives.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from zerocal_sym.errors import ZerocalError
+from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model.noise import NoiseModel
+
+#: Default tolerance of an omitted length error, mm (mechanisms without a table below).
+DEFAULT_LENGTH_TOLERANCE_MM = 0.02
+#: Default tolerance of an omitted angle error, deg.
+DEFAULT_ANGLE_TOLERANCE_DEG = 0.002
+#: Per-mechanism defaults (user units).  planar_2dof: |Table 2 set A| (mm), an example tolerance.
+MECHANISM_TOLERANCES = {
+    "planar_2dof": {"e1x": 0.03, "e1y": 0.02, "e2x": 0.02, "e2y": 0.01,
+                    "L1": 0.01, "L2": 0.02, "l1": 0.03, "l2": 0.02},
+}
+#: The model of the RMS bias: independent errors uniform within their tolerances.
+RMS_MODEL = "independent uniform errors in [-t, t] (variance t^2/3)"
+
+
+def omitted(robot, params="paper") -> tuple:
+    """The source errors a fit of ``params`` holds at zero, in the mechanism's order."""
+    keep = set(robot.errors.resolve(params))
+    return tuple(n for n in robot.errors.names if n not in keep)
+
+
+def default_tolerances(robot, params="paper") -> dict:
+    """Default tolerances of the omitted errors by name, internal units (mm, rad).
+
+    The mechanism's table (:data:`MECHANISM_TOLERANCES`) where it has one,
+    else :data:`DEFAULT_LENGTH_TOLERANCE_MM` per length and
+    :data:`DEFAULT_ANGLE_TOLERANCE_DEG` per angle.
+    """
+    table = MECHANISM_TOLERANCES.get(robot.mechanism_name, {})
+    errors = robot.errors
+    out = {}
+    for name in omitted(robot, params):
+        if name in table:
+            v = table[name]
+        else:
+            v = DEFAULT_ANGLE_TOLERANCE_DEG if errors[name].unit == "rad" else DEFAULT_LENGTH_TOLERANCE_MM
+        out[name] = errors.from_user_value(name, v)
+    return out
+
+
+def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="paper", defaults: bool = True) -> dict:
+    """Tolerances of the omitted errors by name (internal units): defaults, a file, ``NAME=VALUE`` items, a scale.
+
+    Parameters
+    ----------
+    items : sequence of str, optional
+        ``NAME=VALUE`` in user units (mm; deg for angles), later ones win.
+    file : path, optional
+        TOML (``name = value``) or JSON (``{"name": value}``) file, user units;
+        applied before ``items``.
+    scale : float
+        Every tolerance multiplied by this (e.g. 10).
+    defaults : bool
+        Start from :func:`default_tolerances` (else from zero).
+
+    Raises
+    ------
+    ZerocalError
+        Unknown or identified name, a negative or non-finite value, a bad file.
+    """
+    errors = robot.errors
+    names = omitted(robot, params)
+    tol = default_tolerances(robot, params) if defaults else {n: 0.0 for n in names}
+    given = {}
+    if file is not None:
+        given.update(_read_file(file))
+    for it in items or ():
+        k, sep, v = str(it).partition("=")
+        if not sep:
+            raise ZerocalError(f"--tolerance {it!r}: expected NAME=VALUE (mm; deg for angles)")
+        given[k.strip()] = v
+    for k, v in given.items():
+        if k not in names:
+            what = "is identified (no bias from it)" if k in errors.names else "is not a source error"
+            raise ZerocalError(f"tolerance {k!r} {what}; tolerances apply to {', '.join(names)}")
+        try:
+            val = float(v)
+        except (TypeError, ValueError):
+            raise ZerocalError(f"tolerance {k}={v!r}: not a number") from None
+        if not math.isfinite(val) or val < 0:
+            raise ZerocalError(f"tolerance {k}={v!r}: must be finite and >= 0")
+        tol[k] = errors.from_user_value(k, val)
+    try:
+        scale = float(scale)
+    except (TypeError, ValueError):
+        raise ZerocalError(f"tolerance scale {scale!r}: not a number") from None
+    if not math.isfinite(scale) or scale < 0:
+        raise ZerocalError(f"tolerance scale must be finite and >= 0, got {scale!r}")
+    return {n: tol[n] * scale for n in names}
+
+
+def _read_file(path) -> dict:
+    import json
+    import tomllib
+    from pathlib import Path
+
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except OSError as exc:
+        raise ZerocalError(f"cannot read the tolerance file: {exc.strerror}", where=str(path)) from None
+    try:
+        data = json.loads(text) if p.suffix.lower() == ".json" else tomllib.loads(text)
+    except (ValueError, tomllib.TOMLDecodeError) as exc:
+        raise ZerocalError(f"bad tolerance file: {exc}", where=str(path)) from None
+    if not isinstance(data, dict) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                             for v in data.values()):
+        raise ZerocalError("a tolerance file holds name = value pairs (mm; deg for angles)", where=str(path))
+    return dict(data)
+
+
+def tolerance_vector(robot, tolerances, names) -> np.ndarray:
+    """Tolerances of ``names`` (internal units), 0 where not given, shape (r,)."""
+    return np.array([float(tolerances.get(n, 0.0)) for n in names])
+
+
+def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None = None, err0=None):
+    """``S = d(estimate) / d(omitted errors)`` of the weighted least-squares fit, first order.
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, m)
+        Commanded joints in visiting order, rad.
+    params : str or list of str
+        The identified parameters.
+    noise : NoiseModel, optional
+        The estimator's weighting (default the paper's; a zero model: unweighted).
+    err0 : ndarray, shape (q,), optional
+        Linearisation point (default zero).
+
+    Returns
+    -------
+    S : ndarray, shape (p, r)
+        Row per identified parameter, column per omitted error (internal units).
+    names : tuple of str
+        The omitted errors (columns).
+    """
+    noise = NoiseModel.paper() if noise is None else noise
+    from zerocal_sym.identify import fisher
+
+    errors = robot.errors
+    idx = errors.indices(params)
+    names = omitted(robot, params)
+    om = [errors.index(n) for n in names]
+    err0 = errors.zeros() if err0 is None else errors.check_vector(err0)
+    _, de, _ = kin.distance_jacobians(robot, np.atleast_2d(theta_cmd), err0)
+    A, Ao = np.diff(de[:, idx], axis=0), np.diff(de[:, om], axis=0)
+    if noise.is_zero:
+        W = np.eye(A.shape[0])
+    else:
+        W = fisher.whitener(fisher.measurement_covariance(robot, theta_cmd, noise, err0))
+    S, *_ = np.linalg.lstsq(W @ A, W @ Ao, rcond=None)
+    return S, names
+
+
+def tolerance_bias(robot, theta_cmd, tolerances=None, params="paper", noise: NoiseModel | None = None,
+                   err0=None) -> dict:
+    """Worst-case and RMS bias of each identified parameter from the omitted errors' tolerances.
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, m)
+        Commanded joints in visiting order, rad.
+    tolerances : dict name -> value (internal units), optional
+        Default :func:`default_tolerances`.
+
+    Returns
+    -------
+    dict
+        ``params``, ``units`` (user units per parameter), ``worst_case`` and
+        ``rms`` (user units, per parameter), ``zero_offsets`` {``names``,
+        ``worst_case_deg``, ``rms_deg``}, ``tolerances`` (user units by
+        name), ``sensitivity`` (per omitted error, user units per user unit:
+        rows the parameters), ``model``.
+    """
+    errors = robot.errors
+    names = errors.resolve(params)
+    tol = default_tolerances(robot, params) if tolerances is None else dict(tolerances)
+    S, om = bias_sensitivity(robot, theta_cmd, params, noise, err0)
+    t = tolerance_vector(robot, tol, om)
+    worst = np.abs(S) @ t
+    rms = np.sqrt((S ** 2) @ (t ** 2) / 3.0)
+    to_user = np.array([errors.to_user_value(n, 1.0) for n in names])
+    from_user = np.array([errors.from_user_value(n, 1.0) for n in om])
+    off = [names.index(z) for z in errors.zero_offsets if z in names]
+    return {
+        "params": list(names),
+        "units": {n: errors[n].user_unit for n in names},
+        "worst_case": (worst * to_user).tolist(),
+        "rms": (rms * to_user).tolist(),
+        "zero_offsets": {"names": [names[i] for i in off], "worst_case_deg": (worst * to_user)[off].tolist(),
+                         "rms_deg": (rms * to_user)[off].tolist()},
+        "tolerances": {n: errors.to_user_value(n, v) for n, v in zip(om, t)},
+        "tolerance_units": {n: errors[n].user_unit for n in om},
+        "sensitivity": {"rows": list(names), "columns": list(om),
+                        "values": (S * to_user[:, None] * from_user[None, :]).tolist()},
+        "model": f"first order; worst case sum_j |S_ij| t_j; RMS sqrt(sum_j S_ij^2 t_j^2 / 3): {RMS_MODEL}",
+    }
