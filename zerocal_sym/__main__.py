@@ -1,3 +1,4 @@
 from zerocal_sym.cli import entry
 
-entry()
+if __name__ == "__main__":  # not when a spawned worker process re-imports the main module
+    entry()

@@ -43,6 +43,10 @@ def run(args, robot):
     verify = int(getattr(args, "verify", 0) or 0)
     if verify < 0:
         raise design.DesignError(f"--verify N needs N >= 0, got {verify}")
+    from zerocal_sym.cli import _parallel
+    from zerocal_sym.identify.parallel import check_execution
+
+    check_execution(getattr(args, "workers", 1), getattr(args, "scheduler", None))
     starts = int(getattr(args, "starts", 8))
     if starts < 1:
         raise design.DesignError(f"--starts needs at least 1, got {starts}")
@@ -57,15 +61,23 @@ def run(args, robot):
         joint_limits_deg=None if jl is None else [(jl[2 * j], jl[2 * j + 1]) for j in range(robot.m)],
         min_separation_mm=getattr(args, "min_separation", 1.0))
     noise = NoiseModel.named(getattr(args, "noise", "paper"))
-    res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
-                                 exchange_starts=starts)
+    ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
+    try:
+        res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
+                                     exchange_starts=starts)
+    except BaseException:
+        _parallel.close(ex)
+        raise
     out = res.to_dict()
     out["robot"] = robot.name
     out["mechanism"] = robot.mechanism_name
     out["seed"] = args.seed
     if verify:
-        vd = design.verify_design(robot, res.poses, verify, noise, seed=args.seed)
-        vp = design.verify_design(robot, np.asarray(res.paper["poses"]), verify, noise, seed=args.seed)
+        try:
+            vd = design.verify_design(robot, res.poses, verify, noise, seed=args.seed, **ex)
+            vp = design.verify_design(robot, np.asarray(res.paper["poses"]), verify, noise, seed=args.seed, **ex)
+        finally:
+            _parallel.close(ex)
         out["verify"] = {"design": vd, "paper": vp,
                          "rms_ratio_design_over_paper": optimize._ratio(vd["rms_error_rms_deg"],
                                                                         vp["rms_error_rms_deg"]),

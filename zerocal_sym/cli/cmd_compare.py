@@ -30,6 +30,8 @@ Examples:
     zerocal compare --all --trials 100 --json
     zerocal compare --poses poses.csv --params paper --noise scale-only
     zerocal compare --robot examples/delta.toml --set theta1=2 --set theta2=-1 --set theta3=0.5 --trials 20
+    zerocal compare --trials 10000 --workers 2          # local processes; same numbers as --workers 1
+    zerocal compare --trials 100000 --scheduler tcp://host:8786   # a Dask cluster (docs/montecarlo.md)
 """
 NAME = "compare"
 HELP = "Monte Carlo of TSVD vs Ipopt (one-shot, in the loop) vs scipy on the same simulated data"
@@ -63,16 +65,18 @@ def add_arguments(p):
     p.add_argument("--max-iter", type=int, default=20, help="identifications per loop (default 20)")
     p.add_argument("--seed", type=int, default=0, help="seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    from zerocal_sym.cli import _parallel
+
+    _parallel.add_arguments(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, help="also write the JSON here")
 
 
 def run(args):
-    from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.cli import _parallel, load_robot_arg
     from zerocal_sym.cli._common import has_paper_tables, parse_named_values, poses_arg, require_paper_tables
     from zerocal_sym.errors import ZerocalError
-    from zerocal_sym.identify import montecarlo
-    from zerocal_sym.identify.montecarlo import Progress, format_compare
+    from zerocal_sym.identify.montecarlo import format_compare
     from zerocal_sym.io.files import to_json, write_json
     from zerocal_sym.model.noise import NoiseModel
 
@@ -101,23 +105,40 @@ def run(args):
     except ValueError as exc:
         raise ZerocalError(f"--params: {exc}") from None
     noise = NoiseModel.named(args.noise)
+    ex = _parallel.execution(args)  # checked (and a scheduler reached) before any work
     common = dict(trials=args.trials, poses=poses, params=params, noise=noise, seed=args.seed, methods=methods,
-                  mu0_deg=args.mu0, max_iter=args.max_iter)
-    if use_table2:
-        from zerocal_sym.paper.compare import compare
-
-        bar = Progress(args.trials * len(groups), "compare", enabled=not args.quiet and args.trials * len(groups) >= 5)
-        rep = compare(robot, groups=groups, frame=args.frame or "paper", progress=bar,
-                      geometric=not args.no_geometric, **common)
-    else:
-        bar = Progress(args.trials, "compare", enabled=not args.quiet and args.trials >= 5)
-        rep = montecarlo.compare(robot, {"set": truth}, progress=bar,
-                                 settings={"truth": robot.errors.to_dict(truth, user=True),
-                                           "truth_units": {e.name: e.user_unit for e in robot.errors},
-                                           "error_frame": "the robot's"}, **common)
+                  mu0_deg=args.mu0, max_iter=args.max_iter, **ex)
+    try:
+        rep = _run(args, robot, use_table2, groups if use_table2 else None, None if use_table2 else truth, common)
+    finally:
+        _parallel.close(ex)
     rep["settings"]["robot_sha256"] = robot.sha256
     rep["settings"]["mechanism"] = robot.mechanism_name
     if args.out:
         write_json(args.out, rep)
     print(to_json(rep) if args.json else format_compare(rep))
     return 0
+
+
+def _run(args, robot, use_table2, groups, truth, common):
+    from zerocal_sym.identify import montecarlo
+    from zerocal_sym.identify.montecarlo import Progress
+
+    if use_table2:
+        from zerocal_sym.paper.compare import compare
+
+        bar = Progress(args.trials * len(groups), "compare", enabled=not args.quiet and args.trials * len(groups) >= 5)
+        try:
+            return compare(robot, groups=groups, frame=args.frame or "paper", progress=bar,
+                           geometric=not args.no_geometric, **common)
+        finally:
+            bar.close()
+    else:
+        bar = Progress(args.trials, "compare", enabled=not args.quiet and args.trials >= 5)
+        try:
+            return montecarlo.compare(robot, {"set": truth}, progress=bar,
+                                      settings={"truth": robot.errors.to_dict(truth, user=True),
+                                                "truth_units": {e.name: e.user_unit for e in robot.errors},
+                                                "error_frame": "the robot's"}, **common)
+        finally:
+            bar.close()

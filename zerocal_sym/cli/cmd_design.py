@@ -45,6 +45,9 @@ def add_arguments(p):
                         "RW ZMIN ZMAX on a cylinder")
     p.add_argument("--seed", type=int, default=0, help="seed of the multi-start")
     p.add_argument("--verify", type=int, default=0, metavar="N", help="Monte Carlo trials to verify the CRLB")
+    from zerocal_sym.cli import _parallel
+
+    _parallel.add_arguments(p, "--verify")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot the poses in the workspace")
     p.add_argument("--json", action="store_true", help="print JSON")
     # --optimize constraints and settings (issue 5; defaults in zerocal_sym.design)

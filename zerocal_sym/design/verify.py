@@ -45,14 +45,17 @@ def default_true_errors(robot) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- verification
-def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_true=None, seed: int = 0) -> dict:
+def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_true=None, seed: int = 0,
+                  workers: int = 1, scheduler=None, progress=None) -> dict:
     """Monte Carlo check of a design's CRLB with the Ipopt estimator.
 
     Each trial simulates the K scale readings of the virtual plant
     (:class:`~zerocal_sym.model.noise.VirtualPlant`) with fresh noise and
     identifies the paper's p = m + n parameters (zero offsets and MAEMM) with
     :func:`zerocal_sym.identify.nlls.identify_nlls` (same noise model for
-    weighting).
+    weighting), in batches (:func:`zerocal_sym.identify.parallel.one_shot_monte_carlo`:
+    trial t draws from ``SeedSequence([seed, 0, t])``, so the result does not
+    depend on ``workers`` or ``scheduler``).
 
     Parameters
     ----------
@@ -69,6 +72,9 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         geometric errors given here are held at zero by the estimator and
         bias it).
     seed : int
+    workers, scheduler, progress
+        Local processes, or a Dask cluster; ``progress(done)``
+        (:func:`zerocal_sym.identify.parallel.run_chunks`).
 
     Returns
     -------
@@ -81,9 +87,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         (Ipopt not converged, excluded), ``time_s``.
     """
     from zerocal_sym.identify import fisher
-    from zerocal_sym.identify.nlls import identify_nlls
-    from zerocal_sym.model.measurements import Measurements
-    from zerocal_sym.model.noise import VirtualPlant
+    from zerocal_sym.identify.parallel import one_shot_monte_carlo
 
     if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:
         raise DesignError(f"the number of Monte Carlo trials must be a positive integer, got {n_trials!r}")
@@ -99,17 +103,12 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     offsets = errors.zero_offsets
     true_off = errors.take(err, offsets)
     theta = kin.ik(robot, np.asarray(P, float))
-    plant = VirtualPlant(robot, err)
-    rng = np.random.default_rng(seed)
-    E, failed = [], 0
-    for _ in range(n_trials):
-        res = identify_nlls(robot, Measurements(theta, plant.measure(theta, noise, rng)), "paper", noise=noise)
-        if not res.success:
-            failed += 1
-            continue
-        E.append([res.value(name) for name in offsets] - true_off)
+    mc = one_shot_monte_carlo(robot, theta, err, int(n_trials), noise, "paper", seed=seed, workers=workers,
+                              scheduler=scheduler, progress=progress)
+    ok = mc["success"]
+    failed = int(np.sum(~ok))
     m = len(offsets)
-    E = np.degrees(np.array(E).reshape(-1, m))
+    E = np.degrees(mc["estimate"][ok][:, [mc["params"].index(n) for n in offsets]] - true_off).reshape(-1, m)
     crlb = fisher.crlb_zero_offsets_deg(robot, theta, "paper", noise, err0=err)
     return {"n_trials": int(n_trials), "n_failed": failed, "offset_names": list(offsets),
             "rms_error_deg": np.sqrt(np.mean(E ** 2, axis=0)).tolist() if len(E) else [math.nan] * m,

@@ -26,7 +26,7 @@ from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
 
 
-def simulate_round(robot, plant, poses, compensation_rad=None, noise=None, rng=None) -> Measurements:
+def simulate_round(robot, plant, poses, compensation_rad=None, noise=None, rng=None, theta=None) -> Measurements:
     """One identification round: command the poses, read the scale.
 
     Parameters
@@ -40,6 +40,8 @@ def simulate_round(robot, plant, poses, compensation_rad=None, noise=None, rng=N
         Current compensation: commanded = IK(poses) - compensation (default zero).
     noise : NoiseModel, optional
     rng : numpy Generator or seed, optional
+    theta : ndarray, shape (K, m), optional
+        ``IK(poses)`` if already known (a loop commands the same poses every round).
 
     Returns
     -------
@@ -48,7 +50,7 @@ def simulate_round(robot, plant, poses, compensation_rad=None, noise=None, rng=N
     """
     poses = np.atleast_2d(np.asarray(poses, float))
     comp = np.zeros(robot.m) if compensation_rad is None else np.asarray(compensation_rad, float)
-    theta_cmd = kin.ik(robot, poses) - comp
+    theta_cmd = (kin.ik(robot, poses) if theta is None else np.asarray(theta, float)) - comp
     readings = plant.measure(theta_cmd, noise, rng)
     return Measurements(theta_cmd=theta_cmd, readings=readings, target=poses.copy(),
                         meta={}, source="<simulated>")
@@ -152,7 +154,7 @@ class LoopResult:
 
 
 def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rng=None, mu0_deg=0.1,
-                     max_iter=20, maemm_prior=None, run_all=False) -> LoopResult:
+                     max_iter=20, maemm_prior=None, run_all=False, kappa: bool = True, theta=None) -> LoopResult:
     """The paper's iterative identification and compensation (Eq. 30-33).
 
     Each round commands ``IK(poses) - compensation``, measures, and calls
@@ -181,6 +183,12 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
     run_all : bool
         Continue to ``max_iter`` after convergence (the paper's robustness
         study, Fig. 9); the reported state is still the one at convergence.
+    kappa : bool
+        Compute the paper's condition number of G for each identification
+        whose identifier does not report it (False: NaN, and one
+        identification matrix less per round; the Monte Carlo does not use it).
+    theta : ndarray, shape (K, m), optional
+        ``IK(poses)`` if already known.
 
     Returns
     -------
@@ -196,8 +204,9 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
         prior = errors.put(prior, meas_names, np.asarray(maemm_prior, float))
     out = LoopResult(compensation_deg=np.zeros(robot.m), maemm_mm=np.zeros(robot.n))
     comp = np.zeros(robot.m)
+    theta = kin.ik(robot, poses) if theta is None else theta
     for j in range(1, max_iter + 1):
-        meas = simulate_round(robot, plant, poses, comp, noise, rng)
+        meas = simulate_round(robot, plant, poses, comp, noise, rng, theta=theta)
         res = identify(robot, meas, prior.copy())
         if not getattr(res, "success", True):
             raise IdentificationError(f"identification {j} failed: {res.status}")
@@ -205,11 +214,11 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
         maemm = np.array([res.value(n, v) for n, v in zip(meas_names, errors.take(prior, meas_names))])
         inc = new - comp
         mu = None if j == 1 else float(np.degrees(np.sqrt(np.mean(inc**2))))
-        kappa = float(res.info.get("kappa", np.nan)) if isinstance(res.info, dict) else float("nan")
-        if not np.isfinite(kappa):  # the paper's G (Eq. 28) of this round
+        kap = float(res.info.get("kappa", np.nan)) if isinstance(res.info, dict) else float("nan")
+        if kappa and not np.isfinite(kap):  # the paper's G (Eq. 28) of this round
             P = kin.fk(robot, meas.theta_cmd + errors.take(prior, offs))
-            kappa = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
-        out.history.append(IterationRecord(res, np.degrees(new), np.degrees(inc), mu, kappa, maemm.copy()))
+            kap = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
+        out.history.append(IterationRecord(res, np.degrees(new), np.degrees(inc), mu, kap, maemm.copy()))
         comp = new
         prior = errors.put(errors.put(prior, offs, new), meas_names, maemm)
         if not out.converged:

@@ -27,52 +27,22 @@ values do not depend on the frame).
 """
 from __future__ import annotations
 
-import sys
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
-from zerocal_sym.identify.loop import calibration_loop, home_error, simulate_round
+from zerocal_sym.identify.loop import calibration_loop, simulate_round
+from zerocal_sym.identify.parallel import (Progress, Stats, check_execution, chunk_ranges, default_chunk,
+                                          describe_scheduler, run_chunks)
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 
+__all__ = ["METHODS", "Progress", "compare", "format_compare", "scipy_identify"]
+
 METHODS = ("tsvd-loop", "tsvd", "nlls", "nlls-loop", "nlls-seq", "scipy")
-
-
-class Progress:
-    """A progress bar on a stream (stderr), redrawn at most every 0.2 s.
-
-    On a terminal it redraws one line; otherwise it prints a line every 10 %.
-    """
-
-    def __init__(self, total: int, label: str = "compare", stream=None, enabled: bool = True):
-        self.total, self.label, self.enabled = max(1, int(total)), label, enabled
-        self.stream = sys.stderr if stream is None else stream
-        self.t0 = self.last = time.perf_counter()
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.next_pct = 10
-
-    def __call__(self, done: int) -> None:
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        frac = done / self.total
-        el = now - self.t0
-        eta = el / frac - el if frac > 0 else float("nan")
-        bar = "#" * int(30 * frac) + "." * (30 - int(30 * frac))
-        text = f"{self.label} [{bar}] {done}/{self.total}  {el:.1f} s, eta {eta:.0f} s"
-        if self.tty:
-            if done == self.total or now - self.last > 0.2:
-                self.last = now
-                self.stream.write("\r" + text + ("\n" if done == self.total else ""))
-                self.stream.flush()
-        elif 100 * frac >= self.next_pct or done == self.total:
-            while self.next_pct <= 100 * frac:
-                self.next_pct += 10
-            self.stream.write(text + "\n")
-            self.stream.flush()
 
 
 class _Timed:
@@ -125,20 +95,137 @@ def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
                            "time_s": dt}
 
 
-def _stats(E):
-    E = np.asarray(E, float)
-    if E.size == 0:
-        return None, None
-    return np.mean(E, axis=0), np.sqrt(np.mean(E**2, axis=0))
-
-
 def _identity_report(values, which):
     return np.asarray(values, float)
 
 
+@dataclass
+class _CompareTask:
+    """A chunk of trials of one truth (picklable: sent to worker processes)."""
+
+    robot: object
+    err: np.ndarray
+    stream: int
+    poses: np.ndarray
+    names: tuple
+    noise: NoiseModel
+    seed: int
+    methods: tuple
+    mu0_deg: float
+    max_iter: int
+    report: object
+    start: int
+    stop: int
+
+
+class _Acc:
+    """What one method collects over a chunk."""
+
+    def __init__(self):
+        self.E, self.M, self.comp = [], [], []
+        self.fail = self.nc = self.nid = 0
+        self.t = 0.0
+
+    def done(self, robot, plant, m_, n_) -> dict:
+        # dp0 of every compensation of the chunk in one forward-kinematics call (as loop.home_error each)
+        comp = np.reshape(self.comp, (-1, m_))
+        dp0 = (np.linalg.norm(plant.actual_pose(robot.home_joints()[None, :] - comp) - robot.home_pose(), axis=1)
+               if len(comp) else np.zeros(0))
+        return {"E": Stats.of(np.reshape(self.E, (-1, m_))), "M": Stats.of(np.reshape(self.M, (-1, n_))),
+                "dp0": Stats.of(dp0.reshape(-1, 1)), "fail": self.fail, "nc": self.nc,
+                "nid": self.nid, "t": self.t}
+
+
+def _compare_chunk(task: _CompareTask) -> dict:
+    """Trials ``task.start .. task.stop-1`` of one truth, every method (runs in a worker).
+
+    Returns per method the mergeable statistics (:class:`~zerocal_sym.identify.parallel.Stats`)
+    of the offset errors ``E`` (reported frame, deg), the MAEMM errors ``M`` (mm) and ``dp0``
+    (mm), the counters and the time; and the scipy reference's differences and times.
+    """
+    from zerocal_sym.identify.batch import identify_batch
+    from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
+    from zerocal_sym.identify.tsvd import identify_tsvd
+
+    robot, methods, names, noise = task.robot, task.methods, task.names, task.noise
+    errors = robot.errors
+    offs = errors.zero_offsets
+    paper4 = errors.resolve("offsets+measuring")
+    m_, n_ = len(offs), len(errors.measuring)
+    report = task.report or _identity_report
+    plant = VirtualPlant(robot, task.err)
+    true4 = errors.take(task.err, paper4)
+    th0 = kin.ik(robot, task.poses)
+    rec = {m: _Acc() for m in methods}
+    sc_diff, sc_t, ip_t, first = [], [], [], []
+
+    def record(m, est4, t, n_ident=1, converged=True):
+        r = rec[m]
+        r.t += t
+        r.nid += n_ident
+        if est4 is None:
+            r.fail += 1
+            return
+        r.nc += 0 if converged else 1
+        e = est4 - true4
+        r.E.append(report(np.degrees(e[:m_]), "offsets"))
+        r.M.append(report(e[m_:], "maemm"))
+        r.comp.append(est4[:m_])
+
+    for trial in range(task.start, task.stop):
+        ss = np.random.SeedSequence([task.seed, task.stream, trial])
+        meas1 = simulate_round(robot, plant, task.poses, None, noise, np.random.default_rng(ss), theta=th0)
+        for m in ("tsvd-loop", "nlls-loop", "nlls-seq"):
+            if m not in methods and not (m == "tsvd-loop" and "tsvd" in methods):
+                continue
+            ident = _Timed(identify_tsvd if m == "tsvd-loop" else
+                           make_nlls_identifier(params=names, noise=noise, sequential=(m == "nlls-seq")))
+            try:
+                loop = calibration_loop(robot, plant, task.poses, identify=ident, noise=noise,
+                                        rng=np.random.default_rng(ss), mu0_deg=task.mu0_deg,
+                                        max_iter=task.max_iter, kappa=False, theta=th0)
+            except (IdentificationError, ZerocalError):
+                loop = None
+            if m == "tsvd-loop" and "tsvd" in methods:
+                res1 = loop.history[0].result if loop is not None and loop.history else None
+                if res1 is None or not res1.success:
+                    record("tsvd", None, 0.0)
+                else:
+                    record("tsvd", np.array([res1.value(n) for n in paper4]), ident.t / max(1, ident.n))
+            if m not in methods:
+                continue
+            if loop is None:
+                record(m, None, ident.t, ident.n)
+                continue
+            est = np.concatenate([np.radians(loop.compensation_deg), loop.maemm_mm])
+            record(m, est, ident.t, ident.n, loop.converged)
+        if "nlls" in methods:
+            first.append(meas1.readings)
+        if "scipy" in methods:
+            ref = identify_nlls(robot, meas1, names, noise=noise, warm_start=None, reweight=0)
+            p_sc, info = scipy_identify(robot, meas1, names, noise)
+            ok = info["success"] and ref.success
+            record("scipy", np.array([p_sc[names.index(n)] if n in names else 0.0 for n in paper4]) if ok else None,
+                   info["time_s"])
+            if ok:
+                pos = [names.index(n) for n in offs]
+                sc_diff.append(np.max(np.abs(np.degrees(p_sc[pos] - ref.estimate[pos]))))
+                sc_t.append(info["time_s"])
+                ip_t.append(ref.info["time_s"])
+    if "nlls" in methods:  # the one-shot Ipopt of all first rounds in one batch (unconfirmed: the single path)
+        t = time.perf_counter()
+        b = identify_batch(robot, th0, np.array(first), names, noise=noise)
+        dt = (time.perf_counter() - t) / len(first)
+        for k in range(len(first)):
+            record("nlls", b.values(paper4)[k] if b.success[k] else None, dt)
+    return {"methods": {m: rec[m].done(robot, plant, m_, n_) for m in methods},
+            "scipy": {"diff": sc_diff, "t_sc": sc_t, "t_ip": ip_t}}
+
+
 def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise: NoiseModel | None = None,
             seed: int = 0, methods=METHODS, mu0_deg: float = 0.1, max_iter: int = 20,
-            progress=None, report=None, settings=None) -> dict:
+            progress=None, report=None, settings=None, workers: int = 1, scheduler=None,
+            chunk: int | None = None) -> dict:
     """Run the Monte Carlo comparison.
 
     Parameters
@@ -161,36 +248,43 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
         A subset of :data:`METHODS`.
     mu0_deg, max_iter : loop settings.
     progress : callable, optional
-        ``progress(done)`` after each trial.
+        ``progress(done)`` with the trials done (over all truths), after each chunk.
     report : callable, optional
         ``report(values, which)`` with ``which`` ``"offsets"`` (deg, m) or
-        ``"maemm"`` (mm, n): how errors are reported (default: as they are).
+        ``"maemm"`` (mm, n): how errors are reported (default: as they are);
+        picklable (a module-level function or a ``functools.partial`` of one)
+        for ``workers > 1`` or a scheduler.
     settings : dict, optional
         Extra entries for ``rep["settings"]``.
+    workers : int
+        Local worker processes (default 1: this process).
+    scheduler : str or dask.distributed.Client, optional
+        Run the chunks on a Dask cluster instead.
+    chunk : int, optional
+        Trials per chunk (default :func:`~zerocal_sym.identify.parallel.default_chunk`);
+        the results depend on it (the order of the sums), never on ``workers``/``scheduler``.
 
     Returns
     -------
     dict
         ``settings``, ``crlb_zero_offsets_deg`` (per truth, at the truth and the
         first round's poses), and per group and method: ``bias_deg``,
-        ``rms_deg``, ``rms_crlb_ratio`` (zero offsets), ``bias_maemm_mm``,
+        ``rms_deg``, ``rms_crlb_ratio`` (zero offsets), ``quantiles_deg``
+        (``q05``, ``median``, ``q95`` of the offset errors), ``bias_maemm_mm``,
         ``rms_maemm_mm``, ``dp0_rms_mm`` / ``dp0_mean_mm`` / ``dp0_max_mm``
         (home position error after compensating with the estimate),
         ``failures`` (identification failed or raised), ``not_converged``
         (loops that did not reach ``mu < mu0``), ``identifications``
         (per trial, mean), ``time_per_identification_ms``; ``scipy``:
-        ``max_abs_diff_to_ipopt_deg`` and the time ratio.
+        ``max_abs_diff_to_ipopt_deg`` and the time ratio; ``execution``:
+        workers, scheduler, chunks, wall time.
     """
-    from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
-    from zerocal_sym.identify.tsvd import identify_tsvd
-
-    report = report or _identity_report
+    t_wall = time.perf_counter()
     errors = robot.errors
-    offs, meas_names = errors.zero_offsets, errors.measuring
-    paper4 = errors.resolve("offsets+measuring")
-    m_ = len(offs)
-
+    offs = errors.zero_offsets
+    workers = check_execution(workers, scheduler)
     noise = NoiseModel.paper() if noise is None else noise
+    methods = tuple(methods)
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise ZerocalError(f"unknown method(s) {', '.join(unknown)} (known: {', '.join(METHODS)})")
@@ -207,120 +301,85 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
     K = poses.shape[0]
     if K - 1 < len(names):
         raise ZerocalError(f"{K} poses give {K - 1} measured changes: fewer than the {len(names)} parameters")
+    chunk = default_chunk(trials) if chunk is None else int(chunk)
+    ranges = chunk_ranges(int(trials), chunk)
     out = {"settings": {"mechanism": robot.mechanism_name, "groups": [str(g) for g in truths], "trials": trials,
                         "K": K, "poses_mm": poses.tolist(),
                         "params": list(names), "noise": {"sigma_scale_mm": noise.sigma_scale_mm,
                                                          "sigma_servo_rad": noise.sigma_servo_rad},
                         "seed": seed, "methods": list(methods), "mu0_deg": mu0_deg,
-                        "max_iter": max_iter, "error_frame": "ours", **(settings or {})},
+                        "max_iter": max_iter, "chunk": chunk, "error_frame": "ours", **(settings or {})},
            "groups": {}}
-    done = 0
+    tasks, owner, prepared = [], [], []
     for gi, (g, err) in enumerate(truths.items()):
         err = errors.check_vector(err, f"truth {g!r}")
-        plant = VirtualPlant(robot, err)
-        true4 = errors.take(err, paper4)
         stream = g if isinstance(g, int) else gi
+        prepared.append((g, err))
+        for a, b in ranges:
+            tasks.append(_CompareTask(robot, err, stream, poses, names, noise, int(seed), methods, float(mu0_deg),
+                                      int(max_iter), report, a, b))
+            owner.append(gi)
+    results = run_chunks(_compare_chunk, tasks, [t.stop - t.start for t in tasks], workers, scheduler, progress)
+    report = report or _identity_report
+    for gi, (g, err) in enumerate(prepared):
         try:
             crlb = fisher.crlb_zero_offsets_deg(robot, th0, names, noise, err0=err) if not noise.is_zero else None
         except ZerocalError:
             crlb = None
-        rec = {m: {"E": [], "M": [], "dp0": [], "fail": 0, "nc": 0, "nid": 0, "t": 0.0} for m in methods}
-        sc_diff, sc_t, ip_t = [], [], []
-        for trial in range(trials):
-            ss = np.random.SeedSequence([seed, stream, trial])
-            meas1 = simulate_round(robot, plant, poses, None, noise, np.random.default_rng(ss))
-
-            def record(m, est4, t, n_ident=1, converged=True):
-                r = rec[m]
-                r["t"] += t
-                r["nid"] += n_ident
-                if est4 is None:
-                    r["fail"] += 1
-                    return
-                r["nc"] += 0 if converged else 1
-                e = est4 - true4
-                r["E"].append(report(np.degrees(e[:m_]), "offsets"))
-                r["M"].append(report(e[m_:], "maemm"))
-                r["dp0"].append(home_error(robot, plant, est4[:m_]))
-
-            for m in ("tsvd-loop", "nlls-loop", "nlls-seq"):
-                if m not in methods and not (m == "tsvd-loop" and "tsvd" in methods):
-                    continue
-                ident = _Timed(identify_tsvd if m == "tsvd-loop" else
-                               make_nlls_identifier(params=names, noise=noise, sequential=(m == "nlls-seq")))
-                try:
-                    loop = calibration_loop(robot, plant, poses, identify=ident, noise=noise,
-                                            rng=np.random.default_rng(ss), mu0_deg=mu0_deg, max_iter=max_iter)
-                except (IdentificationError, ZerocalError):
-                    loop = None
-                if m == "tsvd-loop" and "tsvd" in methods:
-                    first = loop.history[0].result if loop is not None and loop.history else None
-                    if first is None or not first.success:
-                        record("tsvd", None, 0.0)
-                    else:
-                        record("tsvd", np.array([first.value(n) for n in paper4]), ident.t / max(1, ident.n))
-                if m not in methods:
-                    continue
-                if loop is None:
-                    record(m, None, ident.t, ident.n)
-                    continue
-                est = np.concatenate([np.radians(loop.compensation_deg), loop.maemm_mm])
-                record(m, est, ident.t, ident.n, loop.converged)
-            if "nlls" in methods or "scipy" in methods:
-                t = time.perf_counter()
-                res = identify_nlls(robot, meas1, names, noise=noise)
-                dt = time.perf_counter() - t
-                est = np.array([res.value(n) for n in paper4]) if res.success else None
-                if "nlls" in methods:
-                    record("nlls", est, dt)
-            if "scipy" in methods:
-                ref = identify_nlls(robot, meas1, names, noise=noise, warm_start=None, reweight=0)
-                p_sc, info = scipy_identify(robot, meas1, names, noise)
-                ok = info["success"] and ref.success
-                record("scipy", np.array([p_sc[names.index(n)] if n in names else 0.0 for n in paper4]) if ok else None,
-                       info["time_s"])
-                if ok:
-                    pos = [names.index(n) for n in offs]
-                    sc_diff.append(np.max(np.abs(np.degrees(p_sc[pos] - ref.estimate[pos]))))
-                    sc_t.append(info["time_s"])
-                    ip_t.append(ref.info["time_s"])
-            done += 1
-            if progress:
-                progress(done)
+        mine = [r for r, o in zip(results, owner) if o == gi]  # chunk order
         gout = {"crlb_zero_offsets_deg": None if crlb is None else np.asarray(crlb).tolist(),
                 "set_deg": report(np.degrees(errors.take(err, offs)), "offsets").tolist(),
                 "methods": {}}
         for m in methods:
-            r = rec[m]
-            bias, rms = _stats(r["E"])
-            mb, mr = _stats(r["M"])
-            dp0 = np.asarray(r["dp0"])
-            ok = len(r["E"])
-            gout["methods"][m] = {
-                "trials": trials,
-                "failures": r["fail"],
-                "not_converged": r["nc"] if m.endswith(("loop", "seq")) else None,
-                "bias_deg": None if bias is None else bias.tolist(),
-                "rms_deg": None if rms is None else rms.tolist(),
-                "rms_crlb_ratio": (None if rms is None or crlb is None else (rms / np.asarray(crlb)).tolist()),
-                "bias_maemm_mm": None if mb is None else mb.tolist(),
-                "rms_maemm_mm": None if mr is None else mr.tolist(),
-                "dp0_rms_mm": float(np.sqrt(np.mean(dp0**2))) if ok else None,
-                "dp0_mean_mm": float(np.mean(dp0)) if ok else None,
-                "dp0_max_mm": float(np.max(dp0)) if ok else None,
-                "identifications": r["nid"] / trials if trials else None,
-                "time_per_identification_ms": 1e3 * r["t"] / max(1, r["nid"]),
-            }
-        if "scipy" in methods and sc_t:
+            gout["methods"][m] = _method_summary(m, [r["methods"][m] for r in mine], trials, crlb)
+        sc = {k: [x for r in mine for x in r["scipy"][k]] for k in ("diff", "t_sc", "t_ip")}
+        if "scipy" in methods and sc["t_sc"]:
             gout["scipy_reference"] = {
                 "problem": "whitened residuals, weights at zero, start at zero (Ipopt: warm_start=None, reweight=0)",
-                "max_abs_diff_to_ipopt_deg": float(np.max(sc_diff)),
-                "time_scipy_ms": 1e3 * float(np.mean(sc_t)),
-                "time_ipopt_ms": 1e3 * float(np.mean(ip_t)),
-                "time_ratio_ipopt_over_scipy": float(np.mean(ip_t) / np.mean(sc_t)),
+                "max_abs_diff_to_ipopt_deg": float(np.max(sc["diff"])),
+                "time_scipy_ms": 1e3 * float(np.mean(sc["t_sc"])),
+                "time_ipopt_ms": 1e3 * float(np.mean(sc["t_ip"])),
+                "time_ratio_ipopt_over_scipy": float(np.mean(sc["t_ip"]) / np.mean(sc["t_sc"])),
             }
         out["groups"][str(g)] = gout
+    out["execution"] = {"workers": workers, "scheduler": describe_scheduler(scheduler),
+                        "chunks": len(tasks), "chunk_trials": chunk, "wall_s": time.perf_counter() - t_wall,
+                        "wall_per_trial_ms": 1e3 * (time.perf_counter() - t_wall) / max(1, trials * len(prepared))}
     return out
+
+
+def _method_summary(m, parts, trials, crlb) -> dict:
+    """Merge a method's chunk statistics (in chunk order) into its report entry."""
+    E, M, D = Stats(0), Stats(0), Stats(1)
+    fail = nc = nid = 0
+    t = 0.0
+    for p in parts:
+        E.merge(p["E"])
+        M.merge(p["M"])
+        D.merge(p["dp0"])
+        fail += p["fail"]
+        nc += p["nc"]
+        nid += p["nid"]
+        t += p["t"]
+    bias, rms = E.mean, E.rms
+    q = E.quantiles()
+    ok = E.count > 0
+    return {
+        "trials": trials,
+        "failures": fail,
+        "not_converged": nc if m.endswith(("loop", "seq")) else None,
+        "bias_deg": None if bias is None else bias.tolist(),
+        "rms_deg": None if rms is None else rms.tolist(),
+        "rms_crlb_ratio": (None if rms is None or crlb is None else (rms / np.asarray(crlb)).tolist()),
+        "quantiles_deg": None if q is None else {k: v.tolist() for k, v in q.items()},
+        "bias_maemm_mm": None if M.mean is None else M.mean.tolist(),
+        "rms_maemm_mm": None if M.rms is None else M.rms.tolist(),
+        "dp0_rms_mm": float(D.rms[0]) if ok else None,
+        "dp0_mean_mm": float(D.mean[0]) if ok else None,
+        "dp0_max_mm": float(D.max()[0]) if ok else None,
+        "identifications": nid / trials if trials else None,
+        "time_per_identification_ms": 1e3 * t / max(1, nid),
+    }
 
 
 def _vec(v, fmt):
@@ -356,6 +415,13 @@ def format_compare(rep: dict) -> str:
                          f"{ratio:>{6 * m + 1}s} {_vec(r['rms_maemm_mm'], '7.4f'):>{8 * m}s} {r['dp0_rms_mm']:8.4f} "
                          f"{r['failures']:4d} {nc:>6s} {r['identifications']:5.1f} "
                          f"{r['time_per_identification_ms']:8.2f}")
+        qs = [(name, r["quantiles_deg"]) for name, r in go["methods"].items() if r.get("quantiles_deg")]
+        if qs:
+            lines.append(f"  {'quantiles':10s} {'5% ' + offs + ' [deg]':>{w}s} {'median ' + offs + ' [deg]':>{w}s} "
+                         f"{'95% ' + offs + ' [deg]':>{w}s}")
+            for name, q in qs:
+                lines.append(f"  {name:10s} {_vec(q['q05'], '+10.4f'):>{w}s} {_vec(q['median'], '+10.4f'):>{w}s} "
+                             f"{_vec(q['q95'], '+10.4f'):>{w}s}")
         sr = go.get("scipy_reference")
         if sr:
             lines.append(f"  scipy least_squares (lm) on the same problem: max |diff| to Ipopt "

@@ -6,9 +6,16 @@ runs the generic :func:`zerocal_sym.identify.montecarlo.compare`.
 """
 from __future__ import annotations
 
+from functools import partial
+
 from zerocal_sym.identify import montecarlo
 from zerocal_sym.paper.scheme import paper_poses
 from zerocal_sym.paper.tables import group_errors, to_table_frame
+
+
+def _report(values, which, frame):
+    """Errors in Table 2's frame (module level: picklable for worker processes)."""
+    return to_table_frame(values, frame, which)
 
 
 def compare(robot, groups=(1,), trials: int = 100, poses=None, frame: str = "paper", geometric: bool = True,
@@ -26,7 +33,8 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, frame: str = "pap
         Keep Table 2's geometric errors in the plant (False: only offsets and
         MAEMM, so the 4-parameter model is exact).
     **kwargs
-        ``params``, ``noise``, ``seed``, ``methods``, ``mu0_deg``, ``max_iter``, ``progress``.
+        ``params``, ``noise``, ``seed``, ``methods``, ``mu0_deg``, ``max_iter``, ``progress``,
+        ``workers``, ``scheduler``, ``chunk``.
     """
     errors = robot.errors
     truths = {}
@@ -35,6 +43,6 @@ def compare(robot, groups=(1,), trials: int = 100, poses=None, frame: str = "pap
         truths[g] = err if geometric else errors.put(err, errors.geometry, 0.0)
     poses = paper_poses(robot, 3) if poses is None else poses
     return montecarlo.compare(robot, truths, poses, trials=trials,
-                              report=lambda v, which: to_table_frame(v, frame, which),
+                              report=partial(_report, frame=frame),
                               settings={"frame": frame, "geometric_errors": bool(geometric),
                                         "error_frame": "Table 2's" if frame == "paper" else "ours"}, **kwargs)

@@ -1,0 +1,165 @@
+"""Monte Carlo cost: `zerocal compare` per trial, 1 vs 2 workers, and the study runner's throughput.
+
+Measured in one run (the machine's load average is printed: it is shared):
+
+  compare-1w     `zerocal compare --trials N1` (paper's robot, group 1, all six methods), one
+                 process: wall time per trial (the run inside the command, start-up excluded; the
+                 whole command too), CPU time per trial of the command, and per method the time
+                 per trial (identifications x time per identification).  Target <= 40 ms.
+  compare-2w     the same with `--workers 2` on N2 trials (default 1000): wall per trial, the
+                 speed-up over compare-1w, and 10,000 trials extrapolated from it (labelled so;
+                 `--full` runs the 10,000 instead).  Target < 5 min.
+  study          `zerocal study` on a generated spec (the paper's robot at K = 6, p = 4; the
+                 rotary Delta at K = 12, p = 6; one cell each), one and two workers:
+                 identifications per second (chunks of --chunk trials), and the ratio.
+  single         identify_nlls one data set at a time (the path a trial takes without the
+                 batch), identifications per second, for the ratio batch / single.
+
+Usage: python benchmarks/bench_montecarlo.py [--n1 200] [--n2 1000] [--full] [--study 20000]
+       [--chunk 2000] [--json]
+"""
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+ZEROCAL = [sys.executable, "-m", "zerocal_sym"]
+
+
+def run_cli(args):
+    """(stdout, wall s, cpu s of the child processes)"""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    p = subprocess.run(ZEROCAL + args, check=True, capture_output=True, text=True, cwd=ROOT)
+    wall = time.perf_counter() - t
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    return p.stdout, wall, cpu
+
+
+def compare(trials, workers):
+    out, wall, cpu = run_cli(["compare", "--trials", str(trials), "--group", "1", "--json", "--quiet",
+                              "--workers", str(workers)])
+    rep = json.loads(out)
+    ex = rep["execution"]
+    per_method = {m: r["identifications"] * r["time_per_identification_ms"]
+                  for m, r in rep["groups"]["1"]["methods"].items()}
+    return {"trials": trials, "workers": workers, "command_wall_s": wall, "run_wall_s": ex["wall_s"],
+            "wall_per_trial_ms": ex["wall_per_trial_ms"], "cpu_per_trial_ms": 1e3 * cpu / trials,
+            "per_method_ms_per_trial": per_method}
+
+
+SPEC = """name = "bench-{label}"
+seed = 0
+trials = {trials}
+chunk = {chunk}
+robots = ["{robot}"]
+noise = ["paper"]
+[[design]]
+scheme = "auto"
+[[truth]]
+name = "A"
+{truth}
+"""
+TRUTHS = {"paper": "theta1 = 2\ntheta2 = -1\nrMx = 1\nrMy = 0.5",
+          "delta": "theta1 = 2\ntheta2 = -1\ntheta3 = 0.5\nrMx = 1\nrMy = 0.5\nrMz = -0.5"}
+
+
+def study(label, robot, trials, chunk, workers, tmp):
+    spec = Path(tmp) / f"{label}.toml"
+    spec.write_text(SPEC.format(label=label, trials=trials, chunk=chunk, robot=robot, truth=TRUTHS[label]))
+    out_dir = Path(tmp) / f"{label}-{workers}w"
+    out, wall, cpu = run_cli(["study", str(spec), "--out", str(out_dir), "--json", "--quiet",
+                              "--workers", str(workers)])
+    run = json.loads(out)["run"]
+    return {"label": label, "workers": workers, "trials": trials, "chunk": chunk,
+            "identifications_per_s": run["identifications_per_s"], "run_wall_s": run["wall_s"],
+            "command_wall_s": wall}
+
+
+def single(label, robot_path, n=200):
+    import numpy as np
+
+    from zerocal_sym.cli._common import scheme_poses
+    from zerocal_sym.identify.nlls import identify_nlls
+    from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.model.measurements import Measurements
+    from zerocal_sym.model.noise import NoiseModel, VirtualPlant
+    from zerocal_sym.model.robot import load_robot, paper_robot
+
+    robot = paper_robot() if robot_path == "paper" else load_robot(robot_path)
+    P, _ = scheme_poses(robot)
+    th = kin.ik(robot, P)
+    truth = robot.errors.from_user({k: float(v) for k, v in (line.replace(" ", "").split("=")
+                                                             for line in TRUTHS[label].split("\n"))})
+    plant, noise = VirtualPlant(robot, truth), NoiseModel.paper()
+    rng = np.random.default_rng(0)
+    data = [Measurements(th, plant.measure(th, noise, rng)) for _ in range(n)]
+    identify_nlls(robot, data[0], "paper", noise=noise)
+    t = time.perf_counter()
+    for m in data:
+        identify_nlls(robot, m, "paper", noise=noise)
+    return n / (time.perf_counter() - t)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--n1", type=int, default=200, help="trials of the one-worker compare (default 200)")
+    ap.add_argument("--n2", type=int, default=1000, help="trials of the two-worker compare (default 1000)")
+    ap.add_argument("--full", action="store_true", help="run the 10,000-trial compare with --workers 2")
+    ap.add_argument("--study", type=int, default=20000, help="trials of each study cell (default 20000)")
+    ap.add_argument("--chunk", type=int, default=2000, help="trials per study chunk (default 2000)")
+    ap.add_argument("--json", action="store_true", help="print the figures as JSON")
+    args = ap.parse_args()
+
+    res = {"load_average_before": os.getloadavg(), "cpus": os.cpu_count()}
+    res["compare_1w"] = c1 = compare(args.n1, 1)
+    n2 = 10000 if args.full else args.n2
+    res["compare_2w"] = c2 = compare(n2, 2)
+    c2["speedup_over_1w"] = c1["wall_per_trial_ms"] / c2["wall_per_trial_ms"]
+    startup = c2["command_wall_s"] - c2["run_wall_s"]
+    res["compare_10000_2w_s"] = {"value": (c2["command_wall_s"] if args.full else
+                                           startup + 10000 * c2["wall_per_trial_ms"] / 1e3),
+                                 "measured": bool(args.full),
+                                 "how": ("measured" if args.full else
+                                         f"extrapolated: start-up + 10,000 x the wall per trial of {n2} trials")}
+    res["study"] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, robot in (("paper", "paper"), ("delta", str(ROOT / "examples" / "delta.toml"))):
+            one = study(label, robot, args.study, args.chunk, 1, tmp)
+            two = study(label, robot, args.study, args.chunk, 2, tmp)
+            two["speedup_over_1w"] = two["identifications_per_s"] / one["identifications_per_s"]
+            s1 = single(label, robot)
+            one["single_path_identifications_per_s"] = s1
+            one["batch_over_single"] = one["identifications_per_s"] / s1
+            res["study"] += [one, two]
+    res["load_average_after"] = os.getloadavg()
+    if args.json:
+        print(json.dumps(res, indent=2))
+        return
+    print(f"machine: {res['cpus']} CPUs, load average before {res['load_average_before'][0]:.2f}, "
+          f"after {res['load_average_after'][0]:.2f} (shared: figures are upper bounds)")
+    print(f"compare, 1 worker, {c1['trials']} trials (group 1, all methods): {c1['wall_per_trial_ms']:.1f} ms/trial "
+          f"wall (target <= 40), {c1['cpu_per_trial_ms']:.1f} ms/trial CPU; command {c1['command_wall_s']:.1f} s")
+    print("  per method, ms per trial: " + ", ".join(f"{m} {v:.1f}" for m, v in c1["per_method_ms_per_trial"].items()))
+    print(f"compare, 2 workers, {c2['trials']} trials: {c2['wall_per_trial_ms']:.1f} ms/trial wall, speed-up "
+          f"{c2['speedup_over_1w']:.2f} x over 1 worker; command {c2['command_wall_s']:.1f} s")
+    t10 = res["compare_10000_2w_s"]
+    print(f"compare, 2 workers, 10,000 trials: {t10['value']:.0f} s = {t10['value'] / 60:.1f} min "
+          f"(target < 5 min; {t10['how']})")
+    for s in res["study"]:
+        extra = (f", speed-up {s['speedup_over_1w']:.2f} x" if "speedup_over_1w" in s else
+                 f"; one at a time (identify_nlls) {s['single_path_identifications_per_s']:.0f}/s, "
+                 f"batch/single {s['batch_over_single']:.1f} x")
+        print(f"study {s['label']}, {s['workers']} worker(s), {s['trials']} trials in chunks of {s['chunk']}: "
+              f"{s['identifications_per_s']:.0f} identifications/s{extra}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,69 @@
+"""A Monte Carlo study: robots x designs x noise levels x truths x trials, chunked and resumable.
+
+The spec (TOML; format in ``docs/montecarlo.md`` and
+:mod:`zerocal_sym.identify.study`) crosses robot files, measurement designs
+(a scheme and n, or a pose file), noise levels (paper, scale-only,
+servo-only, or factors of the paper's noise) and true source errors (tables
+of name = value, deg for angles, mm otherwise).  Every cell runs ``trials``
+one-shot Ipopt identifications in chunks; each chunk is written atomically to
+``OUT/<cell-id>/chunk-<k>.npz``.  A rerun skips the chunks on disk (it says
+how many), so an interrupted study resumes.  At the end the summary (per cell
+and parameter: bias, RMS, CRLB, RMS/CRLB, 5 % / median / 95 % of the errors)
+is printed and written to ``OUT/summary.json``; ``--summary DIR`` prints it
+from the chunk files without running anything.
+
+Examples:
+
+    zerocal study examples/study.toml --out runs/study
+    zerocal study examples/study.toml --out runs/study --workers 2
+    zerocal study examples/study.toml --out runs/study --scheduler tcp://host:8786
+    zerocal study examples/study.toml --summary runs/study --json
+"""
+NAME = "study"
+HELP = "a Monte Carlo study over robots, designs, noise levels and truths (chunked, resumable)"
+
+
+def add_arguments(p):
+    from zerocal_sym.cli import _parallel
+
+    p.add_argument("spec", metavar="SPEC.toml", help="the study spec")
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--out", metavar="DIR", help="run the study into DIR (resumes what is there)")
+    g.add_argument("--summary", metavar="DIR", help="only summarise the chunks in DIR")
+    _parallel.add_arguments(p, "the identifications")
+    p.add_argument("--quiet", action="store_true", help="no progress bar, no account of the chunks")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+
+
+def run(args):
+    from zerocal_sym.cli import _parallel
+    from zerocal_sym.identify import study as st
+    from zerocal_sym.identify.parallel import Progress
+    from zerocal_sym.io.files import to_json
+
+    spec = st.load_spec(args.spec)
+    if args.summary is not None:
+        from pathlib import Path
+
+        from zerocal_sym.errors import ZerocalError
+
+        if not Path(args.summary).is_dir():
+            raise ZerocalError("no such study directory", where=args.summary)
+        summary = st.summarize(spec, args.summary)
+    else:
+        ex = _parallel.execution(args)
+        bars = []
+
+        def make_progress(total):
+            bars.append(Progress(total, "study", enabled=not args.quiet and total > 0))
+            return bars[-1]
+
+        try:
+            summary = st.run_study(spec, args.out, log=None if args.quiet else st.log_stderr,
+                                   make_progress=make_progress, **ex)
+        finally:
+            for b in bars:
+                b.close()
+            _parallel.close(ex)
+    print(to_json(summary) if args.json else st.format_summary(summary))
+    return 0
