@@ -31,6 +31,8 @@ from zerocal_sym.errors import ZerocalError
 
 #: the most poses per boundary of a scheme (--n): K = 2n = 100,000 poses
 MAX_N = 50_000
+#: a MAEMM prior beyond this is not a manufacturing error of the measuring mechanism (mm)
+MAEMM_PRIOR_LIMIT_MM = 1000.0
 
 #: the files ``identify --plot DIR`` / ``verify --plot DIR`` / ``reproduce --out DIR`` write into DIR
 IDENTIFY_PLOTS = ("residuals.png", "boundary_errors.png")
@@ -72,6 +74,17 @@ def _n(args) -> None:
     n = getattr(args, "n", None)
     if n is not None and n > MAX_N:
         raise ZerocalError(f"--n {n}: at most {MAX_N} poses per boundary (K = 2n = {2 * MAX_N} poses)")
+
+
+def _maemm_prior(args) -> None:
+    v = getattr(args, "maemm_prior", None)
+    if v is None:
+        return
+    if not all(math.isfinite(x) for x in v):
+        raise ZerocalError("--maemm-prior must be finite numbers (mm)")
+    if any(abs(x) > MAEMM_PRIOR_LIMIT_MM for x in v):
+        raise ZerocalError(f"--maemm-prior {' '.join(f'{x:g}' for x in v)}: beyond the plausible range "
+                           f"+-{MAEMM_PRIOR_LIMIT_MM:g} mm (a manufacturing error of the measuring mechanism)")
 
 
 def _positive(args, dest, what, allow_zero=False) -> None:
@@ -117,6 +130,7 @@ def _identify(args) -> None:
             raise ZerocalError(f"{_opts(bad)}: for --method tsvd only")
         if args.max_iter is not None and args.max_iter < 1:
             raise ZerocalError(f"--max-iter must be >= 1, got {args.max_iter}")
+    _maemm_prior(args)
     if args.report and args.json:
         raise ZerocalError("--report is for the text output: the JSON (--json) holds the report under "
                            "'identifiability'")
@@ -185,6 +199,7 @@ def _design(args) -> None:
             raise ZerocalError(f"{_opts(bad)}: where the --verify Monte Carlo runs: give --verify N")
     _seed(args)
     _n(args)
+    _maemm_prior(args)
     outputs = [("--plot", getattr(args, "plot", None))]
     if hasattr(args, "out"):
         outputs.insert(0, ("--out", args.out))

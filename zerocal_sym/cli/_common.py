@@ -205,6 +205,15 @@ def vector_arg(values, k: int, option: str, names, unit: str):
     return v
 
 
+def write_out(args, obj) -> None:
+    """``--out FILE.json``: the JSON the command prints with ``--json``, written all-or-nothing (if given)."""
+    out = getattr(args, "out", None)
+    if out:
+        from zerocal_sym.io.files import json_safe, write_json
+
+        write_json(out, json_safe(obj))
+
+
 def fmt_values(v, spec=".10g", sep=" ") -> str:
     return sep.join(format(float(x), spec) for x in v)
 

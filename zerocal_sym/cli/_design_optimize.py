@@ -32,7 +32,7 @@ def run(args, robot):
 
     from zerocal_sym import design
     from zerocal_sym.design import constraints, criteria, optimize
-    from zerocal_sym.cli._common import check_scheme, default_n
+    from zerocal_sym.cli._common import check_scheme, default_n, write_out
     from zerocal_sym.io.files import to_json
     from zerocal_sym.model.noise import NoiseModel
 
@@ -86,6 +86,7 @@ def run(args, robot):
     if args.plot:
         design.plot_design(args.plot, robot, res)
         out["plot"] = str(args.plot)
+    write_out(args, out)
     if args.json:
         print(to_json(out))
         return 0

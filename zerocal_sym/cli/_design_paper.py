@@ -25,7 +25,7 @@ def run(args, robot):
     from zerocal_sym.paper.scheme import paper_poses
     from zerocal_sym.identify.linear import identification_matrix
 
-    from zerocal_sym.cli._common import vector_arg
+    from zerocal_sym.cli._common import vector_arg, write_out
 
     errors = robot.errors
     prior = (tuple(vector_arg(args.maemm_prior, len(errors.measuring), "--maemm-prior", errors.measuring, "mm"))
@@ -76,6 +76,7 @@ def run(args, robot):
     }
     if robot.name == "paper":
         out["paper"] = {"n": 3, "kappa_1": PAPER_KAPPA_1, "kappa_m": PAPER_KAPPA_M}
+    write_out(args, out)
     if args.json:
         print(to_json(out))
         return 0

@@ -40,7 +40,7 @@ def _numbers(robot, n, noise_paper, noise_scale):
 def run(args, robot):
     import numpy as np
 
-    from zerocal_sym.cli._common import default_n, min_n, n_params, vector_arg
+    from zerocal_sym.cli._common import default_n, min_n, n_params, vector_arg, write_out
     from zerocal_sym.errors import PoseError, ZerocalError
     from zerocal_sym.identify.linear import condition_number, identification_matrix
     from zerocal_sym.io.files import json_safe, to_json
@@ -100,6 +100,7 @@ def run(args, robot):
                           "crlb_rms_deg_scale_only": float(np.sqrt(np.mean(cs**2)))})
         out["n_table"] = table
     out = json_safe(out)
+    write_out(args, out)
     if args.json:
         print(to_json(out))
         return 0

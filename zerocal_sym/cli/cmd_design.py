@@ -50,6 +50,7 @@ def add_arguments(p):
     _parallel.add_arguments(p, "--verify")
     p.add_argument("--plot", metavar="PNG", default=None, help="plot the poses in the workspace")
     p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--out", metavar="FILE.json", default=None, help="also write the JSON (what --json prints) here")
     # --optimize constraints and settings (issue 5; defaults in zerocal_sym.design)
     p.add_argument("--l0", type=float, default=350.0, metavar="MM",
                    help="scale range l0 in mm (--optimize; default 350, the paper's)")

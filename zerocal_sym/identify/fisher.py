@@ -12,8 +12,15 @@ with the exact derivatives of the generated distance model (CasADi AD).  Noise:
 
 ``F = A^T Cov(s)^-1 A (+ prior precision)``; the CRLB of any unbiased estimator
 is ``F^-1``.
+
+``Cov(s)`` is tridiagonal: it is kept as its two bands
+(:class:`ChangeCovariance`, :func:`change_covariance`) and whitened by its
+lower-bidiagonal Cholesky factor, so memory and time are linear in K (the
+dense :func:`measurement_covariance` is for small K and tests).
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -64,14 +71,148 @@ def sensitivity(robot, theta_cmd, params="paper", err0=None):
     return np.diff(de[:, robot.errors.indices(params)], axis=0)
 
 
-def measurement_covariance(robot, theta_cmd, noise: NoiseModel, err0=None):
-    """Covariance of the K-1 measured changes, shape (K-1, K-1)."""
+class ChangeCovariance:
+    """``Cov(s) = sigma_m^2 I + D diag(v) D^T`` of the K-1 measured changes, kept as its two bands.
+
+    Tridiagonal, (K-1) x (K-1): diagonal ``sigma_m^2 + v_k + v_{k+1}``,
+    sub-diagonal ``-v_{k+1}`` (consecutive changes share a pose), ``v_k`` the
+    variance of ``rho_k`` from the servo error.  Its Cholesky factor ``L`` is
+    lower bidiagonal (diagonal ``l``, sub-diagonal ``b``); whitening ``L^-1 A``
+    is a forward substitution.  Memory and time O(K) (O(K p) for a (K-1, p)
+    matrix): nothing here is (K-1) x (K-1) unless :meth:`dense` is asked for.
+
+    Attributes
+    ----------
+    diag : ndarray, shape (K-1,)
+    off : ndarray, shape (K-2,)
+        ``C[k+1, k] = C[k, k+1]``.
+    """
+
+    def __init__(self, diag, off):
+        self.diag = np.asarray(diag, float).ravel()
+        self.off = np.asarray(off, float).ravel()
+        if self.off.size != max(self.diag.size - 1, 0):
+            raise ValueError(f"off-diagonal of length {self.off.size} for a diagonal of {self.diag.size}")
+        self._chol = None
+
+    @classmethod
+    def from_variances(cls, sigma_scale_mm: float, var_rho) -> "ChangeCovariance":
+        """From ``sigma_m`` (mm) and ``v`` (K,), the variance of each pose's distance (mm^2)."""
+        v = np.asarray(var_rho, float).ravel()
+        return cls(sigma_scale_mm**2 + v[:-1] + v[1:], -v[1:-1])
+
+    @property
+    def n(self) -> int:
+        return self.diag.size
+
+    @property
+    def is_zero(self) -> bool:
+        return not (np.any(self.diag) or np.any(self.off))
+
+    def dense(self) -> np.ndarray:
+        """The full matrix, shape (K-1, K-1) (small problems and tests only)."""
+        C = np.diag(self.diag)
+        if self.n > 1:
+            i = np.arange(self.n - 1)
+            C[i + 1, i] = C[i, i + 1] = self.off
+        return C
+
+    def std(self) -> np.ndarray:
+        """Standard deviation of each change, shape (K-1,)."""
+        return np.sqrt(self.diag)
+
+    def cholesky(self):
+        """``(l, b)``: ``C = L L^T`` with ``L`` lower bidiagonal (``L[k, k] = l[k]``, ``L[k+1, k] = b[k]``).
+
+        Raises
+        ------
+        numpy.linalg.LinAlgError
+            ``C`` is not positive definite (a zero noise model).
+        """
+        if self._chol is None:
+            d, e = self.diag, self.off
+            n = d.size
+            l, b = np.empty(n), np.empty(max(n - 1, 0))
+            dl, el = d.tolist(), e.tolist()
+            prev = 0.0
+            for k in range(n):  # l_k^2 = d_k - b_{k-1}^2, b_k = e_k / l_k
+                q = dl[k] - prev * prev
+                if not q > 0:
+                    raise np.linalg.LinAlgError("the covariance of the changes is not positive definite")
+                lk = math.sqrt(q)
+                l[k] = lk
+                if k < n - 1:
+                    prev = el[k] / lk
+                    b[k] = prev
+            self._chol = (l, b)
+        return self._chol
+
+    def whiten(self, A) -> np.ndarray:
+        """``L^-1 A`` (identity covariance), shape of ``A``: (K-1,) or (K-1, p); O(K p)."""
+        l, b = self.cholesky()
+        return band_forward(l, b, A)
+
+    def factor_times(self, A) -> np.ndarray:
+        """``A L``, ``A`` shape (p, K-1): then ``A C A^T = (A L)(A L)^T`` without the (K-1)^2 matrix."""
+        l, b = self.cholesky()
+        A = np.asarray(A, float)
+        out = A * l
+        if self.n > 1:
+            out[:, :-1] += A[:, 1:] * b
+        return out
+
+    def sandwich(self, A) -> np.ndarray:
+        """``A C A^T`` for ``A`` (p, K-1), O(K p^2) (works for a singular C too)."""
+        A = np.asarray(A, float)
+        out = (A * self.diag) @ A.T
+        if self.n > 1:
+            X = (A[:, 1:] * self.off) @ A[:, :-1].T
+            out += X + X.T
+        return out
+
+    def whitener(self) -> np.ndarray:
+        """``L^-1`` dense, shape (K-1, K-1) (small problems only)."""
+        return self.whiten(np.eye(self.n))
+
+
+def band_forward(l, b, A) -> np.ndarray:
+    """Solve ``L Y = A`` for lower-bidiagonal ``L`` (diagonal ``l`` (n,), sub-diagonal ``b`` (n-1,)).
+
+    The recurrence ``y_k = (a_k - b_{k-1} y_{k-1}) / l_k`` evaluated as a
+    parallel prefix (log2 n vectorised steps of ``y_k = alpha_k y_{k-1} +
+    beta_k``), O(n p log n) flops, O(n p) memory.
+    """
+    l = np.asarray(l, float).ravel()
+    A = np.asarray(A, float)
+    vec = A.ndim == 1
+    Y = (A.reshape(l.size, -1) / l[:, None]).copy()  # beta_k
+    n = l.size
+    if n > 1:
+        alpha = np.empty(n)
+        alpha[0] = 0.0
+        alpha[1:] = -np.asarray(b, float).ravel()[: n - 1] / l[1:]
+        s = 1
+        while s < n:  # Hillis-Steele scan of the affine maps y -> alpha y + beta
+            Y[s:] += alpha[s:, None] * Y[:-s]
+            alpha[s:] = alpha[s:] * alpha[:-s]
+            s *= 2
+    return Y.ravel() if vec else Y
+
+
+def change_covariance(robot, theta_cmd, noise: NoiseModel, err0=None) -> ChangeCovariance:
+    """Covariance of the K-1 measured changes in band form (:class:`ChangeCovariance`), O(K)."""
     theta_cmd = np.atleast_2d(theta_cmd)
-    K = theta_cmd.shape[0]
     _, _, dt = kin.distance_jacobians(robot, theta_cmd, err0)
-    D = difference_matrix(K)
     var_rho = noise.sigma_servo_rad**2 * np.sum(dt**2, axis=1)
-    return noise.sigma_scale_mm**2 * np.eye(K - 1) + (D * var_rho) @ D.T
+    return ChangeCovariance.from_variances(noise.sigma_scale_mm, var_rho)
+
+
+def measurement_covariance(robot, theta_cmd, noise: NoiseModel, err0=None):
+    """Covariance of the K-1 measured changes, dense, shape (K-1, K-1).
+
+    For small K; everything in the package uses :func:`change_covariance` (bands, O(K)).
+    """
+    return change_covariance(robot, theta_cmd, noise, err0).dense()
 
 
 def whitener(cov) -> np.ndarray:
@@ -79,13 +220,15 @@ def whitener(cov) -> np.ndarray:
 
     Parameters
     ----------
-    cov : ndarray, shape (n, n)
+    cov : ndarray, shape (n, n), or ChangeCovariance
 
     Returns
     -------
     ndarray, shape (n, n)
         Lower triangular.
     """
+    if isinstance(cov, ChangeCovariance):
+        return cov.whitener()
     L = np.linalg.cholesky(np.asarray(cov, float))
     return np.linalg.solve(L, np.eye(L.shape[0]))
 
@@ -101,10 +244,11 @@ def fisher_information(robot, theta_cmd, params="paper", noise: NoiseModel | Non
     """
     noise = noise or NoiseModel.paper()
     A = sensitivity(robot, theta_cmd, params, err0)
-    C = measurement_covariance(robot, theta_cmd, noise, err0)
-    if not np.any(C):
+    C = change_covariance(robot, theta_cmd, noise, err0)
+    if C.is_zero:
         raise ValueError("the noise model is zero: the Fisher information is unbounded")
-    F = A.T @ np.linalg.solve(C, A)
+    WA = C.whiten(A)  # banded: O(K p), no (K-1) x (K-1) matrix
+    F = WA.T @ WA
     if prior_std is not None:
         F = F + np.diag(1.0 / np.asarray(prior_std, float) ** 2)
     return F
@@ -178,10 +322,10 @@ def model_bias(robot, theta_cmd, err_true, params="paper", noise: NoiseModel | N
     err0 = robot.errors.zeros() if err0 is None else robot.errors.check_vector(err0)
     _, de, _ = kin.distance_jacobians(robot, theta_cmd, err0)
     A, Ao = np.diff(de[:, idx], axis=0), np.diff(de[:, omit], axis=0)
-    if noise.is_zero:
-        W = np.eye(A.shape[0])
-    else:
-        W = whitener(measurement_covariance(robot, theta_cmd, noise, err0))
     d = np.asarray(err_true, float)[omit] - err0[omit]
-    sol, *_ = np.linalg.lstsq(W @ A, W @ (Ao @ d), rcond=None)
+    y = Ao @ d
+    if not noise.is_zero:  # whitened by the banded Cholesky factor, O(K p)
+        C = change_covariance(robot, theta_cmd, noise, err0)
+        A, y = C.whiten(A), C.whiten(y)
+    sol, *_ = np.linalg.lstsq(A, y, rcond=None)
     return sol

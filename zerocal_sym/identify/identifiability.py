@@ -68,7 +68,7 @@ def scaled_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | Non
     A = fisher.sensitivity(robot, theta_cmd, params, err0) / fisher.parameter_scale(robot, params)
     if noise.is_zero:
         return A
-    return fisher.whitener(fisher.measurement_covariance(robot, theta_cmd, noise, err0)) @ A
+    return fisher.change_covariance(robot, theta_cmd, noise, err0).whiten(A)  # banded: O(K p)
 
 
 def _combination(robot, names, v, scale, tol=1e-3):
@@ -166,8 +166,9 @@ def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel |
     theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
     As = scaled_sensitivity(robot, theta_cmd, names, noise, err0)
     scale = fisher.parameter_scale(robot, names)
-    U, s, Vt = np.linalg.svd(As, full_matrices=True)
     p = len(names)
+    # Vt (p, p) and the singular values; no U (it would be (K-1) x (K-1))
+    _, s, Vt = np.linalg.svd(As, full_matrices=As.shape[0] < p)
     sv = np.zeros(p)
     sv[: s.size] = s
     smax = sv[0] if sv.size else 0.0

@@ -239,7 +239,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         A commanded pose that is not an assembly of the robot.
     """
     from zerocal_sym.model import kinematics as kin
-    from zerocal_sym.identify.fisher import measurement_covariance
+    from zerocal_sym.identify.fisher import change_covariance
     from zerocal_sym.identify.linear import identification_matrix
 
     errors = robot.errors
@@ -272,8 +272,8 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
             "scheme's two boundaries)", where=meas.source)
     C = None
     if noise is not None:
-        C = measurement_covariance(robot, th, noise, err0=prior)
-    noise_std = None if C is None else np.sqrt(np.diag(C))
+        C = change_covariance(robot, th, noise, err0=prior)  # tridiagonal, as bands: O(K)
+    noise_std = None if C is None else C.std()
     if rule == "discrepancy" and t is None and noise_std is None:
         raise ValueError("rule='discrepancy' needs a noise model")
     sol = tsvd_solve(G, b, t=t, rule=rule, rtol=rtol, noise_std=noise_std)
@@ -285,7 +285,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     A = T @ sol.operator()
     m = G.shape[0]
     if C is not None:
-        cov = A @ C @ A.T
+        cov = C.sandwich(A)  # A C A^T from the bands, O(K p^2)
     elif m > sol.t:
         cov = float(lin_res @ lin_res) / (m - sol.t) * (A @ A.T)
     else:

@@ -51,6 +51,8 @@ PAPER_TABLE1 = dict(ex=80.0, ey=0.0, L=375.0, l=825.0, H=632.0, b=480.0, h=150.0
                     cx=0.0, cy=79.0, dx=0.0, dy=51.0)
 
 DEFAULT_SINGULARITY_MARGIN = 0.2
+#: home joint angles beyond this are a unit or typing error (deg; the data files' limit)
+HOME_LIMIT_DEG = 3600.0
 TOP_KEYS = ("name", "mechanism", "units", "singularity_margin", "home")
 TABLES = ("geometry", "workspace")
 
@@ -203,15 +205,27 @@ def _line_of(text: str, key: str):
     return None
 
 
+def _shown(v) -> str:
+    """``v`` for a message: an integer too long to show is named by its digits."""
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) >= 10**30:
+        return f"an integer of {len(str(abs(v)))} digits"
+    return repr(v)
+
+
+def _is_finite_number(v) -> bool:
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return bool(np.isfinite(float(v)))
+    except OverflowError:  # an integer too large for a float (10**400 written out)
+        return False
+
+
 def _check_number(k, v, unit, where):
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise RobotFileError(f"key '{k}' must be a number ({unit}), got {v!r}", where=where(k))
-    try:
-        ok = np.isfinite(float(v))
-    except OverflowError:
-        ok = False
-    if not ok:
-        raise RobotFileError(f"key '{k}' must be a finite number, got {v!r}", where=where(k))
+    if not _is_finite_number(v):
+        raise RobotFileError(f"key '{k}' must be a finite number, got {_shown(v)}", where=where(k))
 
 
 def _check_keys(keys: dict, where) -> None:
@@ -259,6 +273,9 @@ def _check_keys(keys: dict, where) -> None:
                     or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)):
                 raise RobotFileError(f"home must be a list of {mech.m} joint angles (deg), got {v!r}",
                                      where=where(k))
+            if not all(_is_finite_number(x) and abs(float(x)) <= HOME_LIMIT_DEG for x in v):
+                raise RobotFileError(f"home must be {mech.m} finite joint angles within +-{HOME_LIMIT_DEG:g} deg, "
+                                     f"got [{', '.join(_shown(x) for x in v)}]", where=where(k))
             continue
         _check_number(k, v, "mm" if k in ws_cls.keys or k == "singularity_margin" else unit(k), where)
 
