@@ -458,16 +458,20 @@ def test_fuzz_no_traceback(capsys, tmp_path, files, argv):
 
 # =========================================================================== 3. Ctrl-C
 
-@pytest.mark.parametrize("argv", [
-    ["compare", "--trials", "100000", "--out", "OUT"],
-    ["reproduce", "--trials", "100000", "--out", "OUT"],
+@pytest.mark.parametrize("argv, delay", [
+    (["compare", "--trials", "100000", "--out", "OUT"], 1.0),  # importing: 130 even inside exec() of a string
+    (["compare", "--trials", "100000", "--out", "OUT"], 1.8),  # importing scipy, building CasADi functions
+    (["compare", "--trials", "100000", "--out", "OUT"], 3.0),  # inside the Monte Carlo loop
+    (["reproduce", "--trials", "100000", "--out", "OUT"], 3.0),
 ])
-def test_ctrl_c_stops_within_a_second(tmp_path, argv):
+def test_ctrl_c_stops_within_a_second(tmp_path, argv, delay):
+    """SIGINT to ``zerocal`` (what Ctrl-C sends): status 130 (not -2: a clean exit, not death by the signal)
+    within a second or two, one line "interrupted", nothing written."""
     out = tmp_path / "o"
     argv = [str(out) if a == "OUT" else a for a in argv]
     p = subprocess.Popen([sys.executable, "-m", "zerocal_sym", *argv], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
-    time.sleep(3.0)  # started and inside the long loop
+    time.sleep(delay)
     assert p.poll() is None, p.communicate()
     t = time.perf_counter()
     p.send_signal(signal.SIGINT)
@@ -475,8 +479,32 @@ def test_ctrl_c_stops_within_a_second(tmp_path, argv):
     waited = time.perf_counter() - t
     assert p.returncode == 130, err
     assert waited < 3.0, waited
-    assert "Traceback" not in err and err.strip().splitlines()[-1].endswith("interrupted")
+    assert "Traceback" not in err and err.strip().splitlines()[-1].endswith("interrupted"), err
     assert list(tmp_path.iterdir()) == [], "something was written"
+
+
+@pytest.mark.parametrize("exc", [
+    SystemError("<built-in function _function_buffer_eval> returned a result with an exception set"),
+    ImportError("scipy half imported"),
+])
+def test_ctrl_c_inside_an_extension_or_an_import(capsys, monkeypatch, exc):
+    """A KeyboardInterrupt that a C extension turned into SystemError (CasADi), or an import into ImportError
+    and a command into "needs scipy", is still Ctrl-C: 130, one line."""
+    from zerocal_sym.cli import cmd_robot
+    from zerocal_sym.errors import ZerocalError
+
+    def run(args):
+        try:
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt as ki:
+                raise exc from ki
+        except ImportError:
+            raise ZerocalError("the scipy reference needs scipy") from None
+
+    monkeypatch.setattr(cmd_robot, "run", run)
+    rc, out, err = run_cli(capsys, ["robot"])
+    assert rc == 130 and err == "zerocal robot: interrupted\n", err
 
 
 # =========================================================================== 4. scale (the data side)

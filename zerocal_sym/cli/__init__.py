@@ -93,6 +93,8 @@ def main(argv=None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, not at exit
         return status
     except ZerocalError as exc:
+        if _from_interrupt(exc):  # e.g. Ctrl-C inside an import that was turned into "needs X"
+            return _interrupted(args)
         print(f"zerocal {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError as exc:
@@ -105,8 +107,27 @@ def main(argv=None) -> int:
         print(f"zerocal {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"zerocal {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return _interrupted(args)
+    except Exception as exc:
+        if _from_interrupt(exc):  # Ctrl-C inside a C extension (CasADi): "SystemError: ... exception set"
+            return _interrupted(args)
+        raise
+
+
+def _interrupted(args) -> int:
+    print(f"zerocal {args.command}: interrupted", file=sys.stderr)
+    return 130
+
+
+def _from_interrupt(exc) -> bool:
+    """Whether ``exc`` was caused by Ctrl-C (a KeyboardInterrupt in its cause/context chain)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _stdout_closed() -> int:
@@ -128,4 +149,29 @@ def entry() -> None:  # console script
         status = 130
     except BrokenPipeError:
         status = _stdout_closed()
+    if status == 130:
+        _exit_interrupted()
     sys.exit(status)
+
+
+def _exit_interrupted() -> None:
+    """End with status 130 after Ctrl-C, cleanly, whatever CPython noted.
+
+    A Ctrl-C that lands inside ``exec`` of a string (dataclasses and
+    namedtuples are made so) makes CPython note the interrupt as unhandled,
+    and after a normal exit it ends the process by SIGINT (status -2 to a
+    parent process) although we handled it.  So: the exit functions, the
+    streams, then ``os._exit(130)``.
+    """
+    import atexit
+
+    try:
+        atexit._run_exitfuncs()
+    except BaseException:  # noqa: BLE001 - exiting anyway
+        pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
+    os._exit(130)
