@@ -42,7 +42,11 @@ REPRODUCE_FILES = (("fig8.png", "fig9.png", "results.json") + tuple(f"fig12_grou
 
 #: design options that belong to --optimize (dest names)
 DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
-                        "joint_limits", "min_separation", "noise", "starts", "workers", "scheduler")
+                        "joint_limits", "min_separation", "noise", "starts", "workers", "scheduler",
+                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale")
+#: design --target-crlb X: what it takes besides the region and constraint options (it chooses K, crlb)
+DESIGN_TARGET_NOT = ("K", "criterion", "seed", "verify", "plot", "starts", "workers", "scheduler", "method",
+                     "tolerance", "tolerance_file", "tolerance_scale")
 #: design options of the boundary scheme, not --optimize
 DESIGN_SCHEME_ONLY = ("n", "eps0", "maemm_prior")
 
@@ -184,7 +188,12 @@ def _compare(args) -> None:
 
 
 def _design(args) -> None:
-    if not args.optimize:
+    if getattr(args, "target_crlb", None) is not None:  # issue 13: the fewest poses for a CRLB
+        bad = _given(args, *DESIGN_TARGET_NOT, *DESIGN_SCHEME_ONLY) + (["optimize"] if args.optimize else [])
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: not with --target-crlb (it chooses K for the crlb criterion; the "
+                               "region and constraint options apply)")
+    elif not args.optimize:
         bad = _given(args, *DESIGN_OPTIMIZE_ONLY)
         if bad:
             raise ZerocalError(f"{_opts(bad)}: for --optimize only (the boundary scheme has no "

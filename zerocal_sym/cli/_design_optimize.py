@@ -13,8 +13,99 @@ Any mechanism: the design region is the robot's workspace shape (a rectangle
 workspace's boundary scheme with the same K (the paper's scheme, the ring
 scheme), joint limits one ``LO HI`` pair per joint; K defaults to 2n of the
 scheme's default n (6 for the paper's robot, 12 for the Delta).
+
+Issue 13: ``--region reachable [--bounds ...]`` and ``--region polygon X1 Y1
+...`` (the reachable non-singular set, clipped); ``--method
+auto|exact|approx`` (the approximate design with its certificate beyond
+K = 24); ``--criterion position|mse``; ``--tolerance NAME=VALUE``,
+``--tolerance-file``, ``--tolerance-scale`` (the omitted errors' tolerances:
+bias and ``mse``); ``zerocal design --target-crlb X`` -- the fewest poses
+whose design reaches an RMS zero-offset CRLB of X degrees, with the
+certified lower bound (JSON keys ``K`` and ``K_lower_bound``).
 """
 from __future__ import annotations
+
+
+def add_arguments(p):
+    """The options of issue 13 (called by :mod:`zerocal_sym.cli.cmd_design`)."""
+    p.add_argument("--bounds", nargs="+", metavar="MM", default=None,
+                   help="clip of --region reachable: XMIN XMAX YMIN YMAX [ZMIN ZMAX] ('open' for an open side), "
+                        "or RW ZMIN ZMAX (a cylinder on the z axis, 3-D)")
+    p.add_argument("--method", choices=["auto", "exact", "approx"], default="auto",
+                   help="exact (exchange + Ipopt), approx (the optimal design measure, rounded, with a "
+                        "certificate) or auto: exact up to K = 24 (default)")
+    p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
+                   help="tolerance of an error the identification leaves out (mm; deg for angles), repeatable; "
+                        "default: set A of Table 2 (planar), 0.02 mm per length and 0.002 deg per angle (others)")
+    p.add_argument("--tolerance-file", default=None, metavar="FILE",
+                   help="tolerances as name = value (TOML or JSON; mm, deg)")
+    p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S",
+                   help="every tolerance times S (e.g. 10)")
+    p.add_argument("--target-crlb", type=float, default=None, metavar="DEG",
+                   help="the fewest poses whose design reaches this RMS zero-offset CRLB (deg); the region and "
+                        "constraint options apply")
+
+
+def region_arg(values):
+    """``--region`` tokens: a keyword (reachable, polygon ...) as strings, otherwise numbers."""
+    from zerocal_sym.design import DesignError
+
+    if values is None:
+        return None
+    vals = list(values)
+    if vals and str(vals[0]).lower() in ("reachable", "polygon"):
+        return [str(vals[0]).lower()] + vals[1:]
+    out = []
+    for v in vals:
+        try:
+            out.append(float(v))
+        except ValueError:
+            raise DesignError(f"--region {' '.join(map(str, vals))}: {v!r} is not a number (a region is numbers "
+                              "of the workspace's shape, 'reachable' or 'polygon X1 Y1 ...')") from None
+    return out
+
+
+def bounds_arg(values):
+    """``--bounds`` tokens as numbers, ``open`` (or ``inf``/``-inf``, ``none``) an open side: -inf for a MIN, inf for a MAX."""
+    from zerocal_sym.design import DesignError
+
+    if values is None:
+        return None
+    out = []
+    for i, v in enumerate(values):
+        t = str(v).strip().lower()
+        if t in ("open", "none", "inf", "+inf", "-inf"):
+            out.append(float("-inf") if (i % 2 == 0 and t != "inf" and t != "+inf") or t == "-inf" else float("inf"))
+            continue
+        try:
+            out.append(float(t))
+        except ValueError:
+            raise DesignError(f"--bounds: {v!r} is not a number or 'open'") from None
+    return out
+
+
+def constraints_from_args(robot, args):
+    """:class:`zerocal_sym.design.Constraints` from the command line."""
+    from zerocal_sym import design
+
+    jl = getattr(args, "joint_limits", None)
+    if jl is not None and len(jl) != 2 * robot.m:
+        pairs = " ".join(f"LO{j + 1} HI{j + 1}" for j in range(robot.m))
+        raise design.DesignError(f"--joint-limits needs {2 * robot.m} values {pairs} (deg; joints "
+                                 f"{', '.join(robot.mechanism.joint_names)}), got {len(jl)}")
+    return design.make_constraints(
+        robot, region=region_arg(getattr(args, "region", None)), travel_mm=getattr(args, "l0", design.SCALE_RANGE_MM),
+        travel_mode=getattr(args, "travel_mode", "range"), singularity_margin=getattr(args, "margin", None),
+        joint_limits_deg=None if jl is None else [(jl[2 * j], jl[2 * j + 1]) for j in range(robot.m)],
+        min_separation_mm=getattr(args, "min_separation", 1.0), bounds=bounds_arg(getattr(args, "bounds", None)))
+
+
+def tolerances_from_args(robot, args):
+    """Tolerances of the omitted errors (internal units) from ``--tolerance``, ``--tolerance-file``, ``--tolerance-scale``."""
+    from zerocal_sym.identify.bias import make_tolerances
+
+    return make_tolerances(robot, getattr(args, "tolerance", None) or [], getattr(args, "tolerance_file", None),
+                           getattr(args, "tolerance_scale", 1.0))
 
 
 def _fmt(v, spec=".4g"):
@@ -37,6 +128,8 @@ def run(args, robot):
     from zerocal_sym.model.noise import NoiseModel
 
     check_scheme(robot, args.scheme)  # the baseline is the robot's own scheme
+    if getattr(args, "target_crlb", None) is not None:
+        return _run_target(args, robot)
     K = args.K if args.K is not None else 2 * default_n(robot)
     constraints._check_k(K, robot)
     criteria._check_criterion(args.criterion)
@@ -50,21 +143,17 @@ def run(args, robot):
     starts = int(getattr(args, "starts", 8))
     if starts < 1:
         raise design.DesignError(f"--starts needs at least 1, got {starts}")
-    jl = getattr(args, "joint_limits", None)
-    if jl is not None and len(jl) != 2 * robot.m:
-        pairs = " ".join(f"LO{j + 1} HI{j + 1}" for j in range(robot.m))
-        raise design.DesignError(f"--joint-limits needs {2 * robot.m} values {pairs} (deg; joints "
-                                 f"{', '.join(robot.mechanism.joint_names)}), got {len(jl)}")
-    cons = design.make_constraints(
-        robot, region=args.region, travel_mm=getattr(args, "l0", design.SCALE_RANGE_MM),
-        travel_mode=getattr(args, "travel_mode", "range"), singularity_margin=getattr(args, "margin", None),
-        joint_limits_deg=None if jl is None else [(jl[2 * j], jl[2 * j + 1]) for j in range(robot.m)],
-        min_separation_mm=getattr(args, "min_separation", 1.0))
+    tol = tolerances_from_args(robot, args)
+    method = getattr(args, "method", "auto")
+    if method == "exact" and K > constraints.MAX_K_EXACT:
+        raise design.DesignError(f"K = {K} is too large for --method exact (at most {constraints.MAX_K_EXACT}; "
+                                 "--method approx takes any K)")
+    cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"))
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
     try:
         res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
-                                     exchange_starts=starts)
+                                     exchange_starts=starts, tolerances=tol, method=method)
     except BaseException:
         _parallel.close(ex)
         raise
@@ -75,14 +164,18 @@ def run(args, robot):
     if verify:
         try:
             vd = design.verify_design(robot, res.poses, verify, noise, seed=args.seed, **ex)
-            vp = design.verify_design(robot, np.asarray(res.paper["poses"]), verify, noise, seed=args.seed, **ex)
+            vp = None
+            if res.paper is not None:
+                vp = design.verify_design(robot, np.asarray(res.paper["poses"]), verify, noise, seed=args.seed,
+                                          **ex)
         finally:
             _parallel.close(ex)
         out["verify"] = {"design": vd, "paper": vp,
-                         "rms_ratio_design_over_paper": optimize._ratio(vd["rms_error_rms_deg"],
-                                                                        vp["rms_error_rms_deg"]),
+                         "rms_ratio_design_over_paper": None if vp is None else optimize._ratio(
+                             vd["rms_error_rms_deg"], vp["rms_error_rms_deg"]),
                          "estimator": "zerocal_sym.identify.nlls.identify_nlls (Ipopt, exact model, the zero offsets and the MAEMM)"}
-        out["paper"]["verify"] = vp
+        if out["paper"] is not None:
+            out["paper"]["verify"] = vp
     if args.plot:
         design.plot_design(args.plot, robot, res)
         out["plot"] = str(args.plot)
@@ -101,6 +194,7 @@ def _print_text(out, res):
     c = out["constraints"]
     jl = c["joint_limits_deg"]
     base = out.get("baseline", "paper")
+    pp = out["paper"]
     coords, joints = out["pose_names"], out["joint_names"]
     print(f"Optimised measurement poses: robot {out['robot']}, K = {out['K']}, criterion {crit} "
           f"({_desc(crit)})")
@@ -111,41 +205,73 @@ def _print_text(out, res):
     print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, servo {n['sigma_servo_deg']:.4g} deg "
           "per joint per pose")
     ex, co = out["exchange"], out["continuous"]
-    ok = sum(r["feasible"] for r in co["runs"])
-    print(f"method: {out['method']}  (exchange on {ex['n_candidates']} grid candidates: {_fmt(ex['value'])}; "
-          f"Ipopt multi-start, {ok}/{len(co['runs'])} feasible ends: {_fmt(co['value'])}; "
-          f"total {out['timing_s']['total']:.2f} s)")
-    P, Pp = np.array(out["poses"]), np.array(out["paper"]["poses"])
+    if co:
+        ok = sum(r["feasible"] for r in co["runs"])
+        print(f"method: {out['method']}  (exchange on {ex['n_candidates']} grid candidates: {_fmt(ex['value'])}; "
+              f"Ipopt multi-start, {ok}/{len(co['runs'])} feasible ends: {_fmt(co['value'])}; "
+              f"total {out['timing_s']['total']:.2f} s)")
+    else:
+        a = out["approximate"]
+        print(f"method: {out['method']}  (design measure on {a['n_candidates']} candidate poses, "
+              f"{len(a['support'])} support points, counts {a['counts']}; total {out['timing_s']['total']:.2f} s)")
+    P = np.array(out["poses"])
+    Pp = np.array(pp["poses"]) if pp is not None else np.full((0, len(coords)), np.nan)
     J = np.array(out["joints_deg"])
     print()
+    show = len(P) if len(P) <= 40 else 20
     print(f"{'k':>3} " + " ".join(f"{x + ' [mm]':>9}" for x in coords) + " "
-          + " ".join(f"{j + ' [deg]':>12}" for j in joints) + "   | "
-          + " ".join(f"{base + ' ' + x:>9}" for x in coords))
-    for k in range(len(P)):
+          + " ".join(f"{j + ' [deg]':>12}" for j in joints)
+          + ("   | " + " ".join(f"{base + ' ' + x:>9}" for x in coords) if pp is not None else ""))
+    for k in range(show):
         print(f"{k + 1:>3} " + " ".join(f"{v:9.3f}" for v in np.round(P[k], 9) + 0.0) + " "
-              + " ".join(f"{v:12.4f}" for v in J[k]) + "   | "
-              + " ".join(f"{v:9.2f}" for v in np.round(Pp[k], 9) + 0.0))
+              + " ".join(f"{v:12.4f}" for v in J[k])
+              + ("   | " + " ".join(f"{v:9.2f}" for v in np.round(Pp[k], 9) + 0.0) if pp is not None else ""))
+    if show < len(P):
+        print(f"... ({len(P) - show} more poses: --json)")
     print()
-    print(f"{'':34}{'design':>12}{base:>12}{'ratio':>9}")
-    vals, pvals = out["criterion"]["values"], out["paper"]["criterion"]["values"]
+    vals = out["criterion"]["values"]
+    pvals = pp["criterion"]["values"] if pp is not None else {k: None for k in vals}
     units = out["criterion"]["units_all"]
+    print(f"{'':34}{'design':>12}{(base if pp is not None else ''):>12}{('ratio' if pp is not None else ''):>9}")
     for name in vals:
         label = f"{name}{' [' + units[name] + ']' if units[name] else ''}{' *' if name == crit else ''}"
         r = vals[name] / pvals[name] if vals[name] is not None and pvals[name] else None
-        print(f"  {label:32}{_fmt(vals[name]):>12}{_fmt(pvals[name]):>12}{_fmt(r, '.3f'):>9}")
-    cz, pz = out["crlb_zero_offsets_deg"], out["paper"]["crlb_zero_offsets_deg"]
+        print(f"  {label:32}{_fmt(vals[name]):>12}{_fmt(pvals[name]):>12}{_fmt(r, '.4g'):>10}")
+    cz = out["crlb_zero_offsets_deg"]
+    pz = pp["crlb_zero_offsets_deg"] if pp is not None else []
     print(f"  {'CRLB per offset [deg]':32}{' '.join(_fmt(v, '.4f') for v in cz):>12}  "
           f"{' '.join(_fmt(v, '.4f') for v in pz):>12}")
-    print(f"  {'kappa (paper kappa_1)':32}{_fmt(out['kappa']):>12}{_fmt(out['paper']['kappa']):>12}"
+    b, pb = out.get("bias"), (pp or {}).get("bias")
+    if b:
+        print(f"  {'bias worst case [deg]':32}{' '.join(_fmt(v, '.4f') for v in b['worst_case_deg']):>12}  "
+              f"{' '.join(_fmt(v, '.4f') for v in (pb or {}).get('worst_case_deg', [])):>12}")
+        print(f"  {'bias RMS [deg]':32}{' '.join(_fmt(v, '.4f') for v in b['rms_deg']):>12}  "
+              f"{' '.join(_fmt(v, '.4f') for v in (pb or {}).get('rms_deg', [])):>12}")
+    ps, pps = out.get("position"), (pp or {}).get("position")
+    if ps:
+        print(f"  {'position error RMS / max [mm]':32}{_fmt(ps['rms_mm']) + ' / ' + _fmt(ps['max_mm']):>12}  "
+              f"{(_fmt(pps['rms_mm']) + ' / ' + _fmt(pps['max_mm'])) if pps else '':>12}")
+    print(f"  {'kappa (paper kappa_1)':32}{_fmt(out['kappa']):>12}{_fmt((pp or {}).get('kappa')):>12}"
           f"{_fmt(out['ratio']['kappa_design_over_paper'], '.3f'):>9}")
-    print(f"  {'rho span [mm]':32}{out['rho_span_mm']:12.2f}{out['paper']['rho_span_mm']:12.2f}")
+    print(f"  {'rho span [mm]':32}{out['rho_span_mm']:12.2f}{_fmt((pp or {}).get('rho_span_mm'), '.2f'):>12}")
     print(f"  {'min |sin transmission|':32}{out['min_transmission_sine']:12.4f}"
-          f"{out['paper']['min_transmission_sine']:12.4f}")
-    if out["paper"].get("violations"):
-        print(f"  note: the {base} scheme breaks the constraints: {'; '.join(out['paper']['violations'])}")
+          f"{_fmt((pp or {}).get('min_transmission_sine'), '.4f'):>12}")
+    if b:
+        tol = ", ".join(f"{k} {v:g}" for k, v in b["tolerances"].items())
+        print(f"  (bias: first order from the tolerances {tol} (mm, deg); RMS for uniform errors)")
     print()
-    print(f"CRLB ratio design / {base} scheme (RMS over the {len(joints)} offsets): "
-          f"{_fmt(out['ratio']['crlb_rms_design_over_paper'], '.4f')}")
+    if pp is not None:
+        print(f"CRLB ratio design / {out.get('baseline_scheme') or base + ' scheme'} (RMS over the {len(joints)} "
+              f"offsets): {_fmt(out['ratio']['crlb_rms_design_over_paper'], '.4f')}")
+    else:
+        print(f"baseline: none -- {out.get('baseline_note')}")
+    cert = out.get("certificate")
+    if cert:
+        eff = cert.get("efficiency_lower_bound")
+        what = cert["criterion"]
+        print(f"certificate: no {out['K']}-pose design on the {cert['n_candidates']} candidate poses has {what} "
+              f"better than {_fmt(cert['bound'])} {units.get(what, '')}; this design's efficiency >= "
+              f"{_fmt(eff, '.4f')}" + (f" ({cert['note']})" if cert.get("note") else ""))
     if "verify" in out:
         v = out["verify"]
         print()
@@ -158,13 +284,65 @@ def _print_text(out, res):
         w = 9 * m
         print(f"{'':10}{'RMS error [deg]':>{w}}  {'CRLB at truth [deg]':>{w}}{'RMS':>9}{'CRLB':>9}{'failed':>8}")
         for name, x in (("design", d), (base, p)):
+            if x is None:
+                continue
             print(f"  {name:8}" + "".join(f"{e:9.4f}" for e in x["rms_error_deg"]) + "  "
                   + "".join(f"{e:9.4f}" for e in x["crlb_at_truth_deg"])
                   + f"{x['rms_error_rms_deg']:9.4f}{x['crlb_at_truth_rms_deg']:9.4f}{x['n_failed']:8d}")
-        print(f"  ratio design / {base}: RMS error {_fmt(v['rms_ratio_design_over_paper'], '.4f')}, CRLB "
-              f"{_fmt(d['crlb_at_truth_rms_deg'] / p['crlb_at_truth_rms_deg'], '.4f')}")
+        if p is not None:
+            print(f"  ratio design / {base}: RMS error {_fmt(v['rms_ratio_design_over_paper'], '.4f')}, CRLB "
+                  f"{_fmt(d['crlb_at_truth_rms_deg'] / p['crlb_at_truth_rms_deg'], '.4f')}")
     if "plot" in out:
         print(f"plot: {out['plot']}")
+
+
+def _run_target(args, robot):
+    """``--target-crlb X``: the fewest poses (crlb criterion), with the certified lower bound."""
+    import numpy as np
+
+    from zerocal_sym import design
+    from zerocal_sym.cli._common import write_out
+    from zerocal_sym.design import approx
+    from zerocal_sym.io.files import json_safe, to_json
+    from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.model.noise import NoiseModel
+
+    if getattr(args, "plot", None):
+        raise design.DesignError("--plot is for --optimize (a --target-crlb design has K in the hundreds)")
+    cons = constraints_from_args(robot, args)
+    noise = NoiseModel.named(getattr(args, "noise", "paper"))
+    res = approx.fewest_poses(robot, args.target_crlb, cons, noise)
+    P = np.asarray(res["poses"])
+    out = {"robot": robot.name, "mechanism": robot.mechanism_name, "target_crlb_deg": res["target_crlb_deg"],
+           "K": res["K"], "K_lower_bound": res["K_lower_bound"], "crlb_rms_deg": res["crlb_rms_deg"],
+           "crlb_zero_offsets_deg": None, "poses": P.tolist(), "pose_names": list(robot.mechanism.pose_names),
+           "joints_deg": np.degrees(kin.ik(robot, P)).tolist(), "joint_names": list(robot.mechanism.joint_names),
+           "evaluated": res["evaluated"], "approximate": res["approximate"],
+           "constraints": cons.to_dict(), "violations": design.check_design(robot, P, cons),
+           "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_deg": float(np.degrees(noise.sigma_servo_rad))},
+           "bound": "no design of fewer than K_lower_bound poses on the candidate poses reaches the target "
+                    "(certificate of the optimal design measure); K is the fewest poses of the rounded designs",
+           "time_s": res["time_s"]}
+    from zerocal_sym.identify import fisher
+
+    out["crlb_zero_offsets_deg"] = fisher.crlb_zero_offsets_deg(robot, kin.ik(robot, P), "paper", noise).tolist()
+    out = json_safe(out)
+    write_out(args, out)
+    if args.json:
+        print(to_json(out))
+        return 0
+    print(f"Fewest poses for an RMS zero-offset CRLB of {out['target_crlb_deg']:g} deg: robot {out['robot']}, "
+          f"region {cons.region.describe()} mm")
+    print(f"  K = {out['K']} (design CRLB {out['crlb_rms_deg']:.5g} deg; per offset "
+          f"{', '.join(f'{v:.5g}' for v in out['crlb_zero_offsets_deg'])})")
+    print(f"  certified: no design of fewer than {out['K_lower_bound']} poses on the "
+          f"{out['approximate']['n_candidates']} candidate poses can reach it")
+    a = out["approximate"]
+    print(f"  support of the design measure (mm, weight): "
+          + "; ".join(f"{tuple(round(x, 2) for x in s)} {w:.3f}" for s, w in zip(a["support"], a["support_weights"])))
+    print(f"  evaluated K: " + ", ".join(f"{k} -> {v:.5g}" for k, v in out["evaluated"].items()))
+    print(f"  ({out['time_s']:.1f} s; the {out['K']} poses: --json)")
+    return 0
 
 
 def _desc(name):

@@ -38,11 +38,12 @@ def add_arguments(p):
     p.add_argument("--optimize", action="store_true", help="optimise the poses instead of the boundary scheme")
     p.add_argument("--K", type=int, default=None,
                    help="number of poses (--optimize; default 2n of the scheme's default: 6 paper, 12 ring)")
-    p.add_argument("--criterion", choices=["cond", "D", "A", "E", "crlb"], default="crlb",
+    p.add_argument("--criterion", choices=["cond", "D", "A", "E", "crlb", "position", "mse"], default="crlb",
                    help="design criterion (--optimize)")
-    p.add_argument("--region", nargs="+", type=float, metavar="MM", default=None,
-                   help="design region in mm (default: the workspace): XMIN XMAX YMIN YMAX on a rectangle, "
-                        "RW ZMIN ZMAX on a cylinder")
+    p.add_argument("--region", nargs="+", metavar="SPEC", default=None,
+                   help="design region (default: the workspace): XMIN XMAX YMIN YMAX on a rectangle, RW ZMIN ZMAX "
+                        "on a cylinder (mm, reachable everywhere); 'reachable' (the reachable non-singular set, "
+                        "clipped by --bounds); 'polygon X1 Y1 X2 Y2 ...' (planar)")
     p.add_argument("--seed", type=int, default=0, help="seed of the multi-start")
     p.add_argument("--verify", type=int, default=0, metavar="N", help="Monte Carlo trials to verify the CRLB")
     from zerocal_sym.cli import _parallel
@@ -65,6 +66,9 @@ def add_arguments(p):
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only"], default="paper",
                    help="noise model of the Fisher-information criteria (--optimize; default paper)")
     p.add_argument("--starts", type=int, default=8, help="random Ipopt starts and exchange starts (--optimize)")
+    from zerocal_sym.cli import _design_optimize
+
+    _design_optimize.add_arguments(p)  # issue 13: --bounds, --method, --tolerance..., --target-crlb
 
 
 def run(args):
@@ -72,7 +76,7 @@ def run(args):
     from zerocal_sym.cli._common import check_scheme
 
     robot = load_robot_arg(args)
-    if args.optimize:
+    if args.optimize or getattr(args, "target_crlb", None) is not None:
         from zerocal_sym.cli import _design_optimize
 
         return _design_optimize.run(args, robot)

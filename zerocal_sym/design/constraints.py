@@ -36,8 +36,11 @@ from zerocal_sym.design.terms import _call_ik, _reachable, design_params, pose_t
 
 #: smallest K for the planar robot (p = 4 parameters; in general p + 1, see :func:`min_k`)
 MIN_K = 5
-#: largest K accepted (design time grows roughly as K^2: ~15 s at K = 40 with 3 starts)
-MAX_K = 100
+#: largest K accepted (the approximate design; K = 1000 takes seconds)
+MAX_K = 5000
+#: largest K of the exact method (exchange + Ipopt: time grows roughly as K^2, ~15 s at K = 40 with 3 starts,
+#: 1207 s at K = 100 with the default 8 + 8 starts)
+MAX_K_EXACT = 100
 #: the paper's scale range l0, mm
 SCALE_RANGE_MM = 350.0
 TRAVEL_MODES = ("range", "consecutive")
@@ -247,19 +250,70 @@ def workspace_region(robot):
     raise DesignError(f"no design region for a {ws.kind} workspace (known: {', '.join(REGIONS)})")
 
 
-def make_region(robot, region=None):
-    """A validated design region of the robot's workspace shape.
+REGION_KINDS = ("reachable", "polygon")
+
+
+def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_limits_deg=None):
+    """A validated design region.
 
     Parameters
     ----------
-    region : Region, CylinderRegion or sequence of numbers (mm), optional
-        ``XMIN XMAX YMIN YMAX`` for a rectangular workspace, ``RW ZMIN ZMAX``
-        for a cylindrical one; default the workspace.
+    region : optional
+        * ``None``: the workspace;
+        * a :class:`Region`, :class:`CylinderRegion` or
+          :class:`~zerocal_sym.design.regions.ReachableRegion`;
+        * a sequence of numbers (mm) of the workspace's shape, reachable
+          everywhere: ``XMIN XMAX YMIN YMAX`` (rectangle), ``RW ZMIN ZMAX``
+          (cylinder);
+        * ``"reachable"``: the reachable non-singular set (the margin, the
+          joint limits, the home pose's modes), clipped by ``bounds``;
+        * ``("polygon", x1, y1, x2, y2, ...)`` or a
+          :class:`~zerocal_sym.design.regions.Polygon` (planar): the
+          reachable set inside the polygon.
+    bounds : sequence of numbers, optional
+        With ``"reachable"``: a box ``XMIN XMAX YMIN YMAX [ZMIN ZMAX]`` (2n
+        numbers, ``-inf``/``inf`` for open sides) or, in 3-D, a cylinder
+        ``RW ZMIN ZMAX`` (3 numbers).
+    singularity_margin, joint_limits_deg
+        For the reachable set (default the robot's margin, no limits).
 
     Raises
     ------
     DesignError
     """
+    from zerocal_sym.design import regions as rg
+
+    if isinstance(region, str) or (isinstance(region, (list, tuple)) and region and isinstance(region[0], str)):
+        vals = [region] if isinstance(region, str) else list(region)
+        kind = str(vals[0]).lower()
+        margin = robot.singularity_margin if singularity_margin is None else singularity_margin
+        try:
+            if kind == "reachable":
+                if len(vals) > 1:
+                    raise DesignError("--region reachable takes no numbers (give the clip with --bounds)")
+                clip = _make_bounds(robot, bounds)
+                return rg.make_reachable(robot, clip, margin, joint_limits_deg)
+            if kind == "polygon":
+                if robot.n != 2:
+                    raise DesignError(f"a polygon region is planar; robot {robot.name!r} has {robot.n} pose "
+                                      "coordinates (use --region reachable --bounds ...)")
+                if bounds is not None:
+                    raise DesignError("--bounds clips --region reachable; a polygon is its own bound")
+                nums = [_finite(f"polygon coordinate {i + 1}", v) for i, v in enumerate(vals[1:])]
+                if len(nums) % 2:
+                    raise DesignError(f"a polygon needs pairs X Y, got {len(nums)} numbers")
+                return rg.make_reachable(robot, rg.Polygon.make(nums), margin, joint_limits_deg)
+        except rg.RegionError as exc:
+            raise DesignError(str(exc)) from None
+        raise DesignError(f"unknown region {vals[0]!r} (known: reachable, polygon, or numbers: "
+                          f"{' '.join(REGIONS[robot.workspace.kind].arg_names)})")
+    if isinstance(region, rg.Polygon):
+        return rg.make_reachable(robot, region, robot.singularity_margin if singularity_margin is None
+                                 else singularity_margin, joint_limits_deg)
+    if isinstance(region, rg.ReachableRegion):
+        return region
+    if bounds is not None:
+        raise DesignError("--bounds clips the reachable set: use it with --region reachable")
     if region is None:
         return workspace_region(robot)
     kind = robot.workspace.kind
@@ -297,21 +351,65 @@ class Constraints:
         Limits of the joints in the mechanism's order, deg.
     min_separation_mm : float
         Lower bound on the distance between any two poses, mm.
+    mode_signs : tuple of float or None
+        For a reachable region: the signs of the singularity indicators at
+        home; the margin is then signed (``sign_i s_i >= margin``) and the
+        forward kinematics must return the pose.
     """
 
-    region: Region | CylinderRegion
+    region: object
     travel_mm: float = SCALE_RANGE_MM
     travel_mode: str = "range"
     singularity_margin: float = 0.2
     joint_limits_deg: tuple | None = None
     min_separation_mm: float = 1.0
+    mode_signs: tuple | None = None
 
     def to_dict(self):
+        clip = getattr(self.region, "clip", None)
         return {"region_kind": self.region.kind, "region_mm": self.region.as_list(),
+                "region_clip": None if clip is None else clip.kind,
                 "region": self.region.describe(), "travel_mm": self.travel_mm, "travel_mode": self.travel_mode,
                 "singularity_margin": self.singularity_margin,
                 "joint_limits_deg": None if self.joint_limits_deg is None else [list(j) for j in self.joint_limits_deg],
                 "min_separation_mm": self.min_separation_mm}
+
+
+def _make_bounds(robot, bounds):
+    """The clip of a reachable region from ``--bounds`` numbers (None: unclipped)."""
+    from zerocal_sym.design import regions as rg
+
+    if bounds is None:
+        return None
+    if isinstance(bounds, (rg.Box, rg.Polygon, CylinderRegion)):
+        return bounds
+    vals = list(bounds)
+    n = robot.n
+    if robot.n == 3 and len(vals) == 3:
+        rw, zmin, zmax = (_finite(nm, v) for nm, v in zip(("RW", "ZMIN", "ZMAX"), vals))
+        c = CylinderRegion(rw, zmin, zmax)
+        c._check()
+        return c
+    names = [f"{a}{b}" for a in "XYZ"[:n] for b in ("MIN", "MAX")]
+    if len(vals) != 2 * n:
+        alt = " or a cylinder RW ZMIN ZMAX (3)" if n == 3 else ""
+        raise DesignError(f"--bounds needs {2 * n} numbers {' '.join(names)} (mm, inf for an open side){alt}, "
+                          f"got {len(vals)}")
+    out = []
+    for nm, v in zip(names, vals):
+        try:
+            v = float(v)
+        except (TypeError, ValueError):
+            raise DesignError(f"{nm} must be a number, got {v!r}") from None
+        if math.isnan(v):
+            raise DesignError(f"{nm} must be a number or +-inf, got nan")
+        out.append(v)
+    lo, hi = out[0::2], out[1::2]
+    for i in range(n):
+        if not hi[i] - lo[i] >= 1.0:
+            raise DesignError(f"--bounds {names[2 * i]} {lo[i]:g} {names[2 * i + 1]} {hi[i]:g}: need MIN < MAX "
+                              "by at least 1 mm")
+    return rg.Box(tuple(lo), tuple(hi))
 
 
 def _finite(name, v):
@@ -325,18 +423,23 @@ def _finite(name, v):
 
 
 def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="range",
-                     singularity_margin=None, joint_limits_deg=None, min_separation_mm=1.0) -> Constraints:
+                     singularity_margin=None, joint_limits_deg=None, min_separation_mm=1.0,
+                     bounds=None) -> Constraints:
     """Validated :class:`Constraints`.
 
     Parameters
     ----------
     robot : Robot
-    region : Region, CylinderRegion or sequence of numbers in mm, optional
+    region : Region, CylinderRegion, sequence of numbers in mm, "reachable", ("polygon", ...), optional
         ``(XMIN, XMAX, YMIN, YMAX)`` for a rectangular workspace,
         ``(RW, ZMIN, ZMAX)`` for a cylindrical one (:func:`make_region`).
         Default: the robot's workspace.  It must be reachable everywhere (a
         grid is checked: inverse kinematics defined and consistent with
-        forward kinematics, i.e. one assembly mode).
+        forward kinematics, i.e. one assembly mode).  ``"reachable"`` (with
+        ``bounds``) and a polygon are the reachable non-singular set, clipped
+        (:mod:`zerocal_sym.design.regions`).
+    bounds : sequence of numbers, optional
+        The clip of ``"reachable"``.
     travel_mm : float
     travel_mode : {"range", "consecutive"}
     singularity_margin : float, optional
@@ -349,7 +452,6 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     DesignError
         With a message saying what is wrong.
     """
-    region = make_region(robot, region)
     travel_mm = _finite("travel (scale range l0, mm)", travel_mm)
     if travel_mm <= 0:
         raise DesignError(f"the scale range l0 must be positive, got {travel_mm:g} mm")
@@ -375,8 +477,15 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     min_sep = _finite("minimum pose separation", min_separation_mm)
     if min_sep < 0:
         raise DesignError(f"minimum pose separation must be >= 0 mm, got {min_sep:g}")
-    cons = Constraints(region, travel_mm, travel_mode, margin, joint_limits_deg, min_sep)
-    _check_region_reachable(robot, region)
+    region = make_region(robot, region, bounds, margin, joint_limits_deg)
+    signs = None
+    if region.kind == "reachable":
+        from zerocal_sym.design.regions import mode_signs
+
+        signs = tuple(float(v) for v in mode_signs(robot))
+    cons = Constraints(region, travel_mm, travel_mode, margin, joint_limits_deg, min_sep, signs)
+    if signs is None:
+        _check_region_reachable(robot, region)
     return cons
 
 
@@ -422,9 +531,19 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
     if np.any(unreach):
         return out
     t = pose_terms(robot, P)
-    smin = np.min(np.abs(t["s"]), axis=1)
-    for k in np.flatnonzero(smin < cons.singularity_margin - tol):
-        out.append(f"pose {k}: min |sin transmission angle| {smin[k]:.4f} < margin {cons.singularity_margin:g}")
+    if cons.mode_signs is None:
+        smin = np.min(np.abs(t["s"]), axis=1)
+        for k in np.flatnonzero(smin < cons.singularity_margin - tol):
+            out.append(f"pose {k}: min |sin transmission angle| {smin[k]:.4f} < margin {cons.singularity_margin:g}")
+    else:
+        smin = np.min(t["s"] * np.asarray(cons.mode_signs), axis=1)
+        for k in np.flatnonzero(smin < cons.singularity_margin - tol):
+            out.append(f"pose {k}: min signed sin transmission angle {smin[k]:.4f} < margin "
+                       f"{cons.singularity_margin:g} (the home pose's modes)")
+        back = kin.fk(robot, t["theta"])
+        for k in np.flatnonzero(~(np.linalg.norm(back - P, axis=1) < 1e-6)):
+            out.append(f"pose {k} {fmt_pose(np.round(P[k], 3))} mm: forward kinematics gives another assembly "
+                       "mode")
     if cons.joint_limits_deg is not None:
         jl = np.asarray(cons.joint_limits_deg)
         deg = np.degrees(t["theta"])
@@ -454,6 +573,15 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
 def _pointwise_ok(robot, P, cons: Constraints):
     """Per-pose feasibility (region, reach, margin, joint limits), bool shape (K,)."""
     P = np.atleast_2d(P)
+    if cons.mode_signs is not None:
+        from zerocal_sym.design.regions import _feasible
+
+        ok = cons.region.contains(P, _POINT_TOL)
+        if np.any(ok):
+            jl = None if cons.joint_limits_deg is None else np.radians(np.asarray(cons.joint_limits_deg))
+            ok[np.flatnonzero(ok)] = _feasible(robot, P[ok], cons.singularity_margin, jl,
+                                               np.asarray(cons.mode_signs))
+        return ok
     th, ratio = _call_ik(robot, P)
     ok = _reachable(ratio, th, 1e-9) & cons.region.contains(P, _POINT_TOL)
     if not np.any(ok):

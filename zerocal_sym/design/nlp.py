@@ -100,9 +100,21 @@ class _NLP:
             ubg.append(np.broadcast_to(hi, expr.shape[0]).astype(float))
 
         add(ratio, -1 + 1e-9, 1 - 1e-9)
-        if region.kind == "cylinder":  # x^2 + y^2 <= rw^2 (the box bounds give z and the bounding square)
-            add((P[0, :] ** 2 + P[1, :] ** 2) / region.rw ** 2, -np.inf, 1.0)
-        if cons.singularity_margin > 0:
+        clip = getattr(region, "clip", None)
+        cyl = region if region.kind == "cylinder" else (clip if getattr(clip, "kind", "") == "cylinder" else None)
+        if cyl is not None:  # x^2 + y^2 <= rw^2 (the box bounds give z and the bounding square)
+            add((P[0, :] ** 2 + P[1, :] ** 2) / cyl.rw ** 2, -np.inf, 1.0)
+        cells = region.nlp_cells() if hasattr(region, "nlp_cells") else None
+        self.cells, self.p_sym = cells, None
+        if cells:  # a polygon: each pose in a convex cell (its start's), half-planes a x + b y <= c as parameters
+            hmax = max(len(c_) for c_ in cells)
+            par = ca.SX.sym("cells", 3 * hmax, K)
+            for j in range(hmax):
+                add(par[3 * j, :] * P[0, :] + par[3 * j + 1, :] * P[1, :] - par[3 * j + 2, :], -np.inf, 0.0)
+            self.p_sym, self.hmax = ca.vec(par), hmax
+        if cons.mode_signs is not None:  # the reachable set: signed margin (the home pose's modes)
+            add(s * ca.repmat(ca.DM(np.asarray(cons.mode_signs)), 1, K), cons.singularity_margin + 1e-7, np.inf)
+        elif cons.singularity_margin > 0:
             add(s ** 2, (cons.singularity_margin + 1e-7) ** 2, np.inf)
         if cons.joint_limits_deg is not None:
             jl = np.radians(np.asarray(cons.joint_limits_deg))
@@ -204,13 +216,17 @@ class _NLP:
         self.fscale, self.mscale = fscale, mscale
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.max_iter": max_iter,
                 "ipopt.tol": 1e-10, "ipopt.acceptable_tol": 1e-7, "ipopt.constr_viol_tol": 1e-9,
-                "ipopt.bound_relax_factor": 0.0, "error_on_fail": False}
+                "ipopt.bound_relax_factor": 0.0, "error_on_fail": False, "show_eval_warnings": False}
         if criterion in ("cond", "E"):
             opts["ipopt.mu_init"] = 1e-6
         opts.update(ipopt_options or {})
-        self.solver = ca.nlpsol("design", "ipopt", {"x": x, "f": obj, "g": ca.vertcat(*g)}, opts)
+        prob = {"x": x, "f": obj, "g": ca.vertcat(*g)}
+        if self.p_sym is not None:
+            prob["p"] = self.p_sym
+        self.solver = ca.nlpsol("design", "ipopt", prob, opts)
         #: objective and constraints as a Function of x (for checks)
-        self.fg = ca.Function("design_fg", [x], [obj, ca.vertcat(*g)])
+        self.fg = ca.Function("design_fg", [x] + ([self.p_sym] if self.p_sym is not None else []),
+                              [obj, ca.vertcat(*g)])
         self.sm2, self.sx2, self.qs, self.wc = sm2, sx2, qs, wc
 
     def x0(self, P0):
@@ -228,9 +244,24 @@ class _NLP:
         aux = [np.atleast_1d(a_[4](nums)) for a_ in self.aux]
         return np.concatenate([z0.ravel()] + aux)  # z is (n, K) column-major == P0 (K, n) row-major
 
+    def params(self, P0):
+        """The NLP's parameters for a start (each pose's polygon cell), or None."""
+        if self.p_sym is None:
+            return None
+        k = self.cons.region.clip.cell_of(P0)
+        out = np.zeros((self.K, self.hmax, 3))
+        out[:, :, 2] = 1.0  # padding rows: 0 <= 1
+        for i, ci in enumerate(k):
+            H = self.cells[ci]
+            out[i, :len(H)] = H
+        return out.reshape(self.K, -1).ravel()  # column-major (3 hmax, K) == row-major (K, 3 hmax)
+
     def solve(self, P0):
         """Run Ipopt from ``P0`` (K, n); returns (P, status, iterations), P of shape (K, n)."""
-        sol = self.solver(x0=self.x0(P0), lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        kw = {}
+        if self.p_sym is not None:
+            kw["p"] = self.params(P0)
+        sol = self.solver(x0=self.x0(P0), lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg, **kw)
         st = self.solver.stats()
         x = sol["x"].full().ravel()
         z = np.clip(x[:self.n * self.K].reshape(self.K, self.n), -1, 1)

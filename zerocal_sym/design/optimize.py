@@ -39,7 +39,7 @@ import numpy as np
 
 from zerocal_sym.io.files import json_safe
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.design.constraints import (Constraints, CylinderRegion, DesignError, Region, _check_k,
+from zerocal_sym.design.constraints import (MAX_K_EXACT, Constraints, CylinderRegion, DesignError, Region, _check_k,
                                             check_design, make_constraints, workspace_region)
 from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective, evaluate
 from zerocal_sym.design.exchange import exchange_design
@@ -77,7 +77,59 @@ def paper_baseline(robot, K: int, region: Region | CylinderRegion | None = None)
 boundary_baseline = paper_baseline
 
 
+def choose_baseline(robot, K: int, cons: Constraints):
+    """The baseline at K: the first candidate scheme that meets the constraints and identifies the parameters.
+
+    Candidates: on a rectangle or cylinder region, the boundary rule on the
+    region (:func:`paper_baseline`; on the workspace itself the paper's or the
+    ring scheme), then, for a smaller region, the workspace's scheme; on the
+    reachable set or a polygon, the workspace's scheme.  A candidate that
+    breaks a constraint (outside the region, singular, the scale travel, ...)
+    or leaves the Fisher information singular is never the baseline.
+
+    Returns
+    -------
+    P : ndarray, shape (K, n), or None
+    label : str
+    note : str or None
+        Why there is no baseline (or None).
+    rejected : list of dict
+        ``scheme``, ``poses``, ``violations`` of each rejected candidate.
+    """
+    from zerocal_sym.design.criteria import criterion_values
+
+    ws = workspace_region(robot)
+    scheme = robot.workspace.scheme_name
+    region = cons.region
+    cands = []
+    if hasattr(region, "boundary_scheme"):
+        label = f"{scheme} scheme" if region == ws else f"{scheme} rule on the region's boundaries"
+        cands.append((label, paper_baseline(robot, K, region)))
+    if region != ws:
+        cands.append((f"{scheme} scheme on the workspace", paper_baseline(robot, K, ws)))
+    rejected = []
+    for label, P in cands:
+        viol = check_design(robot, P, cons)
+        if not viol and not math.isfinite(criterion_values(robot, P)["crlb"]):
+            viol = ["the Fisher information is singular: the scheme cannot identify the parameters"]
+        if not viol:
+            return P, label, None, rejected
+        rejected.append({"scheme": label, "poses": P.tolist(), "violations": viol})
+    parts = []
+    for r in rejected:
+        more = len(r["violations"]) - 1
+        parts.append(f"the {r['scheme']} breaks the constraints ({r['violations'][0]}"
+                     + (f"; {more} more)" if more else ")"))
+    note = "no baseline: " + "; ".join(parts)
+    return None, "", note, rejected
+
+
 # --------------------------------------------------------------------------- driver
+#: ``method="auto"``: the exact path (exchange + Ipopt) up to this K, the approximate design beyond
+EXACT_MAX_K = 24
+METHODS = ("auto", "exact", "approx")
+
+
 @dataclass
 class DesignResult:
     """An optimised design and its baseline.
@@ -89,15 +141,17 @@ class DesignResult:
     criterion : str
     report : dict
         :func:`evaluate` of the design.
-    paper : dict
-        :func:`evaluate` of the baseline: the workspace's boundary scheme
-        with the same K (:func:`paper_baseline`; the paper's scheme on a
-        rectangle, the ring scheme on a cylinder).
+    paper : dict or None
+        :func:`evaluate` of the baseline (:func:`choose_baseline`): the
+        workspace's boundary scheme with the same K (the paper's scheme on a
+        rectangle, the ring scheme on a cylinder) or the rule on the region's
+        boundaries; None when no candidate meets the constraints
+        (``baseline_note`` says why).
     constraints : Constraints
     exchange : dict
-        The discrete exchange's best (poses, value, starts, time).
+        The discrete exchange's best (poses, value, starts, time); empty on the approximate path.
     continuous : dict
-        The Ipopt multi-start (value, runs, time) before ordering and polish.
+        The Ipopt multi-start (value, runs, time) before ordering and polish; empty on the approximate path.
     method : str
         Which method gave the final design.
     timing : dict
@@ -105,12 +159,22 @@ class DesignResult:
     noise : NoiseModel
     baseline : str
         Name of the baseline scheme (``paper`` | ``ring``).
+    baseline_note : str or None
+    baseline_rejected : list of dict
+    certificate : dict or None
+        The approximate design's bound: the best value any K-pose design on
+        the candidates can reach and the design's efficiency lower bound
+        (:mod:`zerocal_sym.design.approx`); None for ``cond``.
+    approximate : dict or None
+        The approximate design (support, weights, counts) on the approximate path.
+    tolerances : dict or None
+        Tolerances of the omitted errors used (internal units; None: defaults).
     """
 
     poses: np.ndarray
     criterion: str
     report: dict
-    paper: dict
+    paper: dict | None
     constraints: Constraints
     exchange: dict
     continuous: dict
@@ -118,6 +182,12 @@ class DesignResult:
     timing: dict = field(default_factory=dict)
     noise: NoiseModel | None = None
     baseline: str = "paper"
+    baseline_note: str | None = None
+    baseline_rejected: list = field(default_factory=list)
+    baseline_label: str = ""
+    certificate: dict | None = None
+    approximate: dict | None = None
+    tolerances: dict | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
@@ -125,17 +195,23 @@ class DesignResult:
 
     def _dict(self) -> dict:
         rep = dict(self.report)
+        pp = self.paper or {}
         rep.update({
             "K": len(self.poses),
             "method": self.method,
             "baseline": self.baseline,
+            "baseline_scheme": self.baseline_label or None,
+            "baseline_note": self.baseline_note,
+            "baseline_rejected": self.baseline_rejected,
             "paper": self.paper,
             "ratio": {
-                "crlb_rms_design_over_paper": _ratio(self.report["crlb_rms_deg"], self.paper["crlb_rms_deg"]),
+                "crlb_rms_design_over_paper": _ratio(self.report["crlb_rms_deg"], pp.get("crlb_rms_deg")),
                 "criterion_design_over_paper": _ratio(self.report["criterion"]["value"],
-                                                      self.paper["criterion"]["value"]),
-                "kappa_design_over_paper": _ratio(self.report["kappa"], self.paper["kappa"]),
+                                                      pp.get("criterion", {}).get("value")),
+                "kappa_design_over_paper": _ratio(self.report["kappa"], pp.get("kappa")),
             },
+            "certificate": self.certificate,
+            "approximate": self.approximate,
             "constraints": self.constraints.to_dict(),
             "noise": None if self.noise is None else {"sigma_scale_mm": self.noise.sigma_scale_mm,
                                                       "sigma_servo_deg": math.degrees(self.noise.sigma_servo_rad)},
@@ -148,6 +224,8 @@ class DesignResult:
 
 
 def _ratio(a, b):
+    if a is None or b is None:
+        return None
     try:
         r = a / b
     except ZeroDivisionError:
@@ -155,23 +233,59 @@ def _ratio(a, b):
     return float(r) if math.isfinite(r) else None
 
 
+def _certificate(ad, criterion, value, K, design_value_crlb=None):
+    """The certificate block of a design from an approximate design of the same criterion (or crlb for mse)."""
+    if ad is None:
+        return None
+    d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K),
+         "measure_efficiency_lower_bound": ad.eff_lb, "n_candidates": ad.n_candidates,
+         "rho_window_mm": list(ad.window), "windows": ad.windows,
+         "model": "order-free pose model (servo variance + sigma_m^2/4 per pose): its optimum bounds every "
+                  "ordered K-pose design on the candidates"}
+    if criterion == ad.criterion:
+        d["design_value"] = value
+        d["efficiency_lower_bound"] = ad.efficiency(value, K)
+    else:  # mse: the variance part alone is bounded
+        d["note"] = ("the mse criterion is not convex: no certificate; bound = the smallest RMS CRLB of any "
+                     "K-pose design (a lower bound on the RMS error)")
+        d["design_value"] = design_value_crlb
+        d["efficiency_lower_bound"] = None if design_value_crlb is None else ad.efficiency(design_value_crlb, K)
+    return d
+
+
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
-                    exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None) -> DesignResult:
+                    exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None,
+                    method: str = "auto", certificate: bool = True) -> DesignResult:
     """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
-    Stages: discrete exchange (``exchange_starts`` seeded starts over the
-    candidate grid); Ipopt multi-start from the boundary scheme (if feasible)
-    and ``n_starts`` seeded random feasible designs; the better of the two,
-    re-ordered (:func:`best_order`) and, if re-ordered, polished by Ipopt
-    from the exchange design as well; the best feasible design wins.
+    Two paths (``method``):
+
+    * ``exact`` -- discrete exchange (``exchange_starts`` seeded starts over
+      the candidate grid); Ipopt multi-start from the boundary scheme (if
+      feasible) and ``n_starts`` seeded random feasible designs; the better
+      of the two, re-ordered (:func:`best_order`) and, if re-ordered,
+      polished by Ipopt from the exchange design as well; the best feasible
+      design wins;
+    * ``approx`` -- the optimal design measure over candidate poses
+      (:func:`zerocal_sym.design.approx.approximate_design`), rounded to K
+      poses with replicates around its support and a visiting order
+      (:func:`zerocal_sym.design.approx.realize`); seconds for K in the
+      hundreds.  ``mse``: the measure is improved locally for the bias
+      (:func:`zerocal_sym.design.approx.mse_measure`); ``cond``: exact only.
+    * ``auto`` (default) -- ``exact`` for K <= :data:`EXACT_MAX_K` (and for
+      ``cond``), ``approx`` beyond.
+
+    With ``certificate`` the approximate design of the criterion (of crlb for
+    mse) also gives the bound on what any K-pose design on the candidates
+    can reach and the design's efficiency lower bound (``cond``: none).
 
     Parameters
     ----------
     robot : Robot
     K : int
         Number of poses (>= p + 1: 5 for the planar robot, 7 for the Delta).
-    criterion : {"cond", "D", "A", "E", "crlb"}
+    criterion : {"cond", "D", "A", "E", "crlb", "position", "mse"}
     cons : Constraints, optional
         Default :func:`make_constraints` (workspace, l0 = 350 mm range,
         the robot's margin, no joint limits).
@@ -182,48 +296,90 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     grid : tuple of int, optional
         Candidate grid of the exchange (default the region's, see
         :func:`zerocal_sym.design.exchange.candidate_grid`).
+    tolerances : dict name -> value (internal units), optional
+        Tolerances of the omitted errors (``mse`` and the bias report;
+        default :func:`zerocal_sym.identify.bias.default_tolerances`).
+    method : {"auto", "exact", "approx"}
+    certificate : bool
 
     Returns
     -------
     DesignResult
     """
+    from zerocal_sym.design import approx as apx
+
     _check_k(K, robot)
     _check_criterion(criterion)
+    if method not in METHODS:
+        raise DesignError(f"unknown design method {method!r} (known: {', '.join(METHODS)})")
+    if method == "auto":
+        method = "exact" if K <= EXACT_MAX_K or criterion == "cond" else "approx"
+    if method == "approx" and criterion == "cond":
+        raise DesignError("the condition number has no approximate design (it is not concave): use the exact "
+                          f"method (K <= {MAX_K_EXACT})")
+    if method == "exact" and K > MAX_K_EXACT:
+        raise DesignError(f"K = {K} is too large for the exact method (at most {MAX_K_EXACT}; the approximate "
+                          "method takes any K)")
     noise = noise or NoiseModel.paper()
     _noise_terms(noise)
     cons = cons or make_constraints(robot)
     timing = {}
     t0 = time.perf_counter()
-    ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances)
-    timing["exchange"] = time.perf_counter() - t0
-    base = paper_baseline(robot, K, cons.region)
+    ad = None
+    mcrit = "crlb" if criterion == "mse" else criterion
+    if method == "approx" or (certificate and criterion != "cond"):
+        ad = apx.approximate_design(robot, mcrit, cons, noise, tolerances=tolerances)
+        timing["approximate"] = time.perf_counter() - t0
+    base, base_label, base_note, rejected = choose_baseline(robot, K, cons)
     scheme = robot.workspace.scheme_name
-    starts = [(f"{scheme} scheme", base)] if not check_design(robot, base, cons) else []
-    t1 = time.perf_counter()
-    cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances)
-    timing["continuous"] = time.perf_counter() - t1
-    nlp = cont.pop("nlp")
-    cands = [("continuous", cont["poses"], cont["objective"]), ("exchange", ex["poses"], ex["objective"])]
-    t2 = time.perf_counter()
-    polished = []
-    for label, P, o in cands:
-        if reorder:
-            order, _ = best_order(robot, P, criterion, noise, cons, tolerances=tolerances)
-            if np.any(order != np.arange(K)):
-                P = P[order]
-                label = label + " +order"
-        Pp, status, _ = nlp.solve(P)
-        op = _objective(robot, criterion, Pp, noise, tolerances)
-        if not check_design(robot, Pp, cons) and op <= _objective(robot, criterion, P, noise, tolerances):
-            polished.append((label + " +ipopt", Pp, op))
-        else:
-            polished.append((label, P, _objective(robot, criterion, P, noise, tolerances)))
-    timing["order_polish"] = time.perf_counter() - t2
-    polished = [c for c in polished if not check_design(robot, c[1], cons)]
-    if not polished:
-        raise DesignError("neither method produced a design that meets the constraints")
-    label, P, _ = min(polished, key=lambda c: c[2])
+    ex, cont, approx_info = {}, {}, None
+    if method == "approx":
+        t1 = time.perf_counter()
+        mad = ad
+        if criterion == "mse":
+            mad = apx.mse_measure(robot, ad, K, cons, noise, tolerances)
+        P, info = apx.realize(robot, mad, K, cons, noise, tolerances, criterion)
+        timing["round_order"] = time.perf_counter() - t1
+        label = "approximate +round +order"
+        approx_info = mad.to_dict(K)
+        approx_info["counts"] = info["counts"]
+        approx_info["orders_tried"] = info["orders_tried"]
+    else:
+        t1 = time.perf_counter()
+        ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances)
+        timing["exchange"] = time.perf_counter() - t1
+        starts = [(f"{scheme} scheme", base)] if base is not None else []
+        t1 = time.perf_counter()
+        cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances)
+        timing["continuous"] = time.perf_counter() - t1
+        nlp = cont.pop("nlp")
+        cands = [("continuous", cont["poses"], cont["objective"]), ("exchange", ex["poses"], ex["objective"])]
+        t2 = time.perf_counter()
+        polished = []
+        for label, P, o in cands:
+            if reorder:
+                order, _ = best_order(robot, P, criterion, noise, cons, tolerances=tolerances)
+                if np.any(order != np.arange(K)):
+                    P = P[order]
+                    label = label + " +order"
+            Pp, status, _ = nlp.solve(P)
+            op = _objective(robot, criterion, Pp, noise, tolerances)
+            if not check_design(robot, Pp, cons) and op <= _objective(robot, criterion, P, noise, tolerances):
+                polished.append((label + " +ipopt", Pp, op))
+            else:
+                polished.append((label, P, _objective(robot, criterion, P, noise, tolerances)))
+        timing["order_polish"] = time.perf_counter() - t2
+        polished = [c for c in polished if not check_design(robot, c[1], cons)]
+        if not polished:
+            raise DesignError("neither method produced a design that meets the constraints")
+        label, P, _ = min(polished, key=lambda c: c[2])
+    report = evaluate(robot, P, criterion, noise, cons, tolerances)
     timing["total"] = time.perf_counter() - t0
-    return DesignResult(poses=P, criterion=criterion, report=evaluate(robot, P, criterion, noise, cons, tolerances),
-                        paper=evaluate(robot, base, criterion, noise, cons, tolerances), constraints=cons, exchange=ex,
-                        continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme)
+    cert = None
+    if ad is not None:
+        cert = _certificate(ad, criterion, report["criterion"]["value"], K, report["criterion"]["values"]["crlb"])
+    paper = None if base is None else evaluate(robot, base, criterion, noise, cons, tolerances)
+    return DesignResult(poses=P, criterion=criterion, report=report, paper=paper, constraints=cons, exchange=ex,
+                        continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme,
+                        baseline_note=base_note, baseline_rejected=rejected, baseline_label=base_label,
+                        certificate=cert, approximate=approx_info, tolerances=tolerances)

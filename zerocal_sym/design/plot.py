@@ -17,10 +17,19 @@ def _labels(result):
     d = result.to_dict()
     ratio = d["ratio"]["crlb_rms_design_over_paper"]
     base = f"{result.baseline}'s scheme" if result.baseline == "paper" else f"{result.baseline} scheme"
+    crlb = result.report["crlb_rms_deg"]
+    fmt = ".3f" if crlb >= 0.01 else ".3g"
+    if result.paper is None:
+        return (base, None, f"{result.criterion}-optimal (CRLB {format(crlb, fmt)} deg)",
+                f"K = {len(result.poses)}, criterion {result.criterion}; no feasible baseline")
     return (base, f"{base} (CRLB {result.paper['crlb_rms_deg']:.3f} deg)",
-            f"{result.criterion}-optimal (CRLB {result.report['crlb_rms_deg']:.3f} deg)",
+            f"{result.criterion}-optimal (CRLB {format(crlb, fmt)} deg)",
             f"K = {len(result.poses)}, criterion {result.criterion}; CRLB ratio design/{result.baseline} "
-            f"{'-' if ratio is None else format(ratio, '.3f')}")
+            f"{'-' if ratio is None else format(ratio, '.3g')}")
+
+
+def _baseline_poses(result, n):
+    return np.asarray(result.paper["poses"]) if result.paper is not None else np.empty((0, n))
 
 
 def _numbered(ax, X, Y, color="tab:blue"):
@@ -50,15 +59,21 @@ def _plot_2d(fig, plt, robot, result):
         ax.contourf(X, Y, Z, levels=[0, cons.singularity_margin], colors=["#f4c7c3"])
         ax.contour(X, Y, Z, levels=[cons.singularity_margin], colors=["#c0392b"], linewidths=0.8)
     ax.add_patch(plt.Rectangle(ws.lo, *(ws.hi - ws.lo), fill=False, ec="k", lw=1.2, label="workspace"))
-    if reg != ws:
+    if reg.kind == "reachable":  # the feasible set: the region's own membership on the plot grid
+        inside = reg.contains(grid, 0.0).reshape(49, 97).astype(float)
+        ax.contour(X, Y, inside, levels=[0.5], colors=["tab:green"], linestyles="--", linewidths=1.2)
+        ax.plot([], [], "--", color="tab:green", label="design region (reachable)")
+    elif reg != ws:
         ax.add_patch(plt.Rectangle(reg.lo, *(reg.hi - reg.lo), fill=False, ec="tab:green", ls="--", lw=1.2,
                                    label="design region"))
-    Pp = np.asarray(result.paper["poses"])
-    ax.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10, label=base_label)
+    Pp = _baseline_poses(result, 2)
+    if len(Pp):
+        ax.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10, label=base_label)
     P = result.poses
     ax.plot(P[:, 0], P[:, 1], "-", color="tab:blue", lw=0.6, alpha=0.6)
     ax.plot(P[:, 0], P[:, 1], "o", color="tab:blue", label=design_label)
-    _numbered(ax, P[:, 0], P[:, 1])
+    if len(P) <= 40:
+        _numbered(ax, P[:, 0], P[:, 1])
     ax.set_aspect("equal")
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
@@ -74,17 +89,25 @@ def _plot_3d(fig, plt, robot, result):
     reg = cons.region
     _, base_label, design_label, title = _labels(result)
     top, side = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
-    P, Pp = result.poses, np.asarray(result.paper["poses"])
+    P, Pp = result.poses, _baseline_poses(result, 3)
     t = np.linspace(0, 2 * np.pi, 241)
+    cyl = reg if reg.kind == "cylinder" else getattr(reg, "clip", None)
+    cyl = cyl if getattr(cyl, "kind", "") == "cylinder" else None
     # top view
     top.plot(ws.rw * np.cos(t), ws.rw * np.sin(t), "k-", lw=1.2, label="workspace")
-    if reg != ws:
-        top.plot(reg.rw * np.cos(t), reg.rw * np.sin(t), "--", color="tab:green", lw=1.2, label="design region")
-    top.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10, label=base_label)
+    if cyl is not None and cyl != ws:
+        top.plot(cyl.rw * np.cos(t), cyl.rw * np.sin(t), "--", color="tab:green", lw=1.2, label="design region")
+    elif reg.kind == "reachable":
+        top.add_patch(plt.Rectangle(reg.lo[:2], *(reg.hi[:2] - reg.lo[:2]), fill=False, ec="tab:green", ls="--",
+                                    lw=1.2, label="design region (bounding box)"))
+    if len(Pp):
+        top.plot(Pp[:, 0], Pp[:, 1], "s", mfc="none", mec="tab:gray", ms=10, label=base_label)
     top.plot(P[:, 0], P[:, 1], "-", color="tab:blue", lw=0.6, alpha=0.6)
     top.plot(P[:, 0], P[:, 1], "o", color="tab:blue", label=design_label)
-    _numbered(top, P[:, 0], P[:, 1])
-    lim = max(ws.rw, reg.rw) + 20
+    if len(P) <= 40:
+        _numbered(top, P[:, 0], P[:, 1])
+    rmax = float(np.max(np.hypot(P[:, 0], P[:, 1]))) if len(P) else 0.0
+    lim = max(ws.rw, cyl.rw if cyl is not None else 0.0, rmax) + 20
     top.set_xlim(-lim, lim)
     top.set_ylim(-lim, lim)
     top.set_aspect("equal")
@@ -93,14 +116,17 @@ def _plot_3d(fig, plt, robot, result):
     top.set_title("top view", fontsize=9)
     # side view: radius against z
     side.add_patch(plt.Rectangle((0, ws.zmin), ws.rw, ws.zmax - ws.zmin, fill=False, ec="k", lw=1.2))
-    if reg != ws:
-        side.add_patch(plt.Rectangle((0, reg.zmin), reg.rw, reg.zmax - reg.zmin, fill=False, ec="tab:green",
+    if cyl is not None and cyl != ws:
+        side.add_patch(plt.Rectangle((0, cyl.zmin), cyl.rw, cyl.zmax - cyl.zmin, fill=False, ec="tab:green",
                                      ls="--", lw=1.2))
     rp, r = np.hypot(Pp[:, 0], Pp[:, 1]), np.hypot(P[:, 0], P[:, 1])
-    side.plot(rp, Pp[:, 2], "s", mfc="none", mec="tab:gray", ms=10)
+    if len(Pp):
+        side.plot(rp, Pp[:, 2], "s", mfc="none", mec="tab:gray", ms=10)
     side.plot(r, P[:, 2], "o", color="tab:blue")
-    _numbered(side, r, P[:, 2])
-    zlo, zhi = min(ws.zmin, reg.zmin) - 20, max(ws.zmax, reg.zmax) + 20
+    if len(P) <= 40:
+        _numbered(side, r, P[:, 2])
+    zs = np.concatenate([[ws.zmin, ws.zmax, reg.lo[2], reg.hi[2]], P[:, 2]])
+    zlo, zhi = float(zs.min()) - 20, float(zs.max()) + 20
     side.set_xlim(-10, lim)
     side.set_ylim(zlo, zhi)
     side.set_aspect("equal")
