@@ -236,6 +236,8 @@ def test_study_resumes_to_the_same_summary(tmp_path):
     other.write_text(other.read_text().replace("seed = 4", "seed = 5"))
     with pytest.raises(ZerocalError, match="other settings.*seed"):
         study.run_study(study.load_spec(other), out)
+    with pytest.raises(ZerocalError, match="other settings.*seed"):
+        study.summarize(study.load_spec(other), out)
 
 
 def test_study_cli_runs_and_summarises(tmp_path, capsys):

@@ -553,6 +553,7 @@ def summarize(study: Study, out) -> dict:
     out = Path(out)
     cells = []
     for cell in study.cells:
+        _cell_json(out, cell, study, check_only=True)  # chunks of other settings are not merged
         errors = cell.robot.errors
         names = cell.params
         conv = np.array([math.degrees(1.0) if errors[n].unit == "rad" else 1.0 for n in names])
