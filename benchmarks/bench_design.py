@@ -1,4 +1,4 @@
-"""Design time of `zerocal design --optimize` (issue 5) for K = 6 and K = 20.
+"""Design time of `zerocal design --optimize` (issue 5) for K = 6 and K = 20, and the issue-13 cases.
 
 For each K and criterion, times the full design (discrete exchange + Ipopt
 multi-start + order search + polish, :func:`zerocal_sym.design.optimize_design`)
@@ -6,7 +6,14 @@ and, as baselines measured in the same run, one Ipopt start (NLP build + one
 solve from the paper's scheme) and the discrete exchange alone; prints the
 ratios, the stage breakdown and what the design achieved.
 
+Issue 13 (printed after the table; ``--only-issue13`` skips the table): the K = 6 crlb design over the
+reachable set of the paper's robot with y >= 450 mm, the 350 mm travel limit and the default margin (its
+CRLB, the certified bound, the baseline); K = 100 designs (the approximate method: the exact one took
+1207 s at K = 100 before issue 13) on the paper's robot and the Delta; ``zerocal design --target-crlb 0.04``
+in the paper's workspace (the fewest K and its certified lower bound); each with its wall time.
+
 Usage: python benchmarks/bench_design.py [--repeat N] [--K 6 20] [--criteria crlb cond] [--starts 8]
+                                         [--only-issue13] [--no-issue13]
 """
 import argparse
 import statistics
@@ -35,7 +42,59 @@ def main():
     ap.add_argument("--K", type=int, nargs="+", default=[6, 20])
     ap.add_argument("--criteria", nargs="+", default=["crlb", "cond"])
     ap.add_argument("--starts", type=int, default=8)
+    ap.add_argument("--only-issue13", action="store_true", help="only the issue-13 cases")
+    ap.add_argument("--no-issue13", action="store_true", help="skip the issue-13 cases")
     a = ap.parse_args()
+    if not a.only_issue13:
+        table(a)
+    if not a.no_issue13:
+        issue13()
+
+
+def issue13():
+    from zerocal_sym.design import approx
+    from zerocal_sym.model.robot import load_robot
+    from pathlib import Path
+
+    robot, noise = paper_robot(), NoiseModel.paper()
+    print()
+    print("issue 13 (paper noise, default margin, l0 = 350 mm range, seed 0, 8 + 8 starts on the exact path)")
+    t = time.perf_counter()
+    cons = design.make_constraints(robot, region="reachable", bounds=(-float("inf"), float("inf"), 450,
+                                                                       float("inf")))
+    t_region = time.perf_counter() - t
+    t = time.perf_counter()
+    res = design.optimize_design(robot, 6, "crlb", cons, noise, seed=0)
+    d = res.to_dict()
+    print(f"reachable set, y >= 450 mm, K = 6, crlb: CRLB {d['crlb_rms_deg']:.5f} deg per offset "
+          f"{[round(v, 5) for v in d['crlb_zero_offsets_deg']]}; certified bound {d['certificate']['bound']:.5f} deg "
+          f"(efficiency >= {d['certificate']['efficiency_lower_bound']:.3f}); baseline {d['baseline_scheme']} "
+          f"{d['paper']['crlb_rms_deg']:.4f} deg; bias worst/RMS {max(d['bias']['worst_case_deg']):.4f}/"
+          f"{max(d['bias']['rms_deg']):.4f} deg; rho span {d['rho_span_mm']:.1f} mm; region {t_region:.2f} s, "
+          f"design {time.perf_counter() - t:.2f} s ({d['method']})")
+    print("    poses (mm): " + "; ".join(f"({x:.1f}, {y:.1f})" for x, y in res.poses))
+    for label, rob in (("paper", robot), ("delta", load_robot(Path(__file__).resolve().parents[1] / "examples"
+                                                                  / "delta.toml"))):
+        for crit in ("crlb", "D"):
+            t = time.perf_counter()
+            res = design.optimize_design(rob, 100, crit, None, noise, seed=0)
+            td = time.perf_counter() - t
+            d = res.to_dict()
+            c = d["certificate"]
+            print(f"K = 100, {label}, {crit}: {td:.2f} s ({d['method']}); {crit} {d['criterion']['value']:.5g}, "
+                  f"bound {c['bound']:.5g}, efficiency >= {c['efficiency_lower_bound']:.3f}; CRLB "
+                  f"{d['crlb_rms_deg']:.5f} deg vs {d['baseline_scheme']} {d['paper']['crlb_rms_deg']:.4f}")
+    t = time.perf_counter()
+    out = approx.fewest_poses(robot, 0.04, design.make_constraints(robot), noise)
+    print(f"--target-crlb 0.04 (paper workspace): K = {out['K']} (CRLB {out['crlb_rms_deg']:.5f} deg), certified "
+          f"lower bound {out['K_lower_bound']}; {time.perf_counter() - t:.2f} s")
+    t = time.perf_counter()
+    out = approx.fewest_poses(robot, 0.04, design.make_constraints(robot, min_separation_mm=0.1), noise)
+    print(f"--target-crlb 0.04 --min-separation 0.1: K = {out['K']} (CRLB {out['crlb_rms_deg']:.5f} deg), "
+          f"lower bound {out['K_lower_bound']}; {time.perf_counter() - t:.2f} s")
+
+
+def table(a):
     robot = paper_robot()
     noise = NoiseModel.paper()
     cons = design.make_constraints(robot)

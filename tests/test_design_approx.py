@@ -388,6 +388,27 @@ def test_bias_aware_design_trades_crlb_for_bias(robot, reach450):
     assert m["crlb_rms_deg"] >= c["crlb_rms_deg"]
 
 
+def test_worst_case_bias_model(robot, reach450):
+    """mse with the worst-case bias: the criterion is sqrt(mean(CRLB^2 + worst^2)); its design lowers the worst case."""
+    tw = bias.make_tolerances(robot, scale=10, bias_model="worst")
+    P = design.paper_baseline(robot, 6)
+    rep = design.evaluate(robot, P, "mse", NOISE, tolerances=tw)
+    want = np.sqrt(np.mean(np.square(rep["crlb_zero_offsets_deg"]) + np.square(rep["bias"]["worst_case_deg"])))
+    assert rep["criterion"]["values"]["mse"] == pytest.approx(want, rel=1e-8)
+    rng = np.random.default_rng(2)
+    Q = design_nlp._random_start(robot, 7, reach450, rng)
+    fs, ms = design_nlp._scales(robot, Q, NOISE)
+    nlp = design_nlp._NLP(robot, 7, "mse", reach450, NOISE, fs, ms, tolerances=tw)
+    f, _ = nlp.fg(nlp.x0(Q))  # the epigraph starts at |B| (1 + 1e-6)
+    assert float(f) - np.log(fs) == pytest.approx(criteria._objective(robot, "mse", Q, NOISE, tw), abs=1e-5)
+    kw = dict(seed=0, n_starts=2, exchange_starts=2)
+    w = design.optimize_design(robot, 6, "mse", reach450, NOISE, tolerances=tw, **kw)
+    c = design.optimize_design(robot, 6, "crlb", reach450, NOISE, certificate=False, **kw)
+    assert w.report["criterion"]["value"] < 0.6 * design.criterion_values(robot, c.poses, NOISE, tw)["mse"]
+    with pytest.raises(Exception, match="bias model"):
+        bias.make_tolerances(robot, bias_model="median")
+
+
 # ----------------------------------------------------------------- the position criterion
 def test_position_criterion(robot):
     P = design.paper_baseline(robot, 6)

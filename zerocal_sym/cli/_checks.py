@@ -43,10 +43,10 @@ REPRODUCE_FILES = (("fig8.png", "fig9.png", "results.json") + tuple(f"fig12_grou
 #: design options that belong to --optimize (dest names)
 DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
                         "joint_limits", "min_separation", "noise", "starts", "workers", "scheduler",
-                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale")
+                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
 #: design --target-crlb X: what it takes besides the region and constraint options (it chooses K, crlb)
 DESIGN_TARGET_NOT = ("K", "criterion", "seed", "verify", "plot", "starts", "workers", "scheduler", "method",
-                     "tolerance", "tolerance_file", "tolerance_scale")
+                     "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
 #: design options of the boundary scheme, not --optimize
 DESIGN_SCHEME_ONLY = ("n", "eps0", "maemm_prior")
 

@@ -41,6 +41,9 @@ def add_arguments(p):
                    help="tolerances as name = value (TOML or JSON; mm, deg)")
     p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S",
                    help="every tolerance times S (e.g. 10)")
+    p.add_argument("--bias-model", choices=["rms", "worst"], default="rms",
+                   help="how --criterion mse counts the bias: rms (expected, errors uniform within the "
+                        "tolerances; default) or worst (the worst case within them)")
     p.add_argument("--target-crlb", type=float, default=None, metavar="DEG",
                    help="the fewest poses whose design reaches this RMS zero-offset CRLB (deg); the region and "
                         "constraint options apply")
@@ -105,7 +108,7 @@ def tolerances_from_args(robot, args):
     from zerocal_sym.identify.bias import make_tolerances
 
     return make_tolerances(robot, getattr(args, "tolerance", None) or [], getattr(args, "tolerance_file", None),
-                           getattr(args, "tolerance_scale", 1.0))
+                           getattr(args, "tolerance_scale", 1.0), bias_model=getattr(args, "bias_model", "rms"))
 
 
 def _fmt(v, spec=".4g"):

@@ -6,28 +6,38 @@ Generic over the mechanism (issue 10): poses (K, n), joints (K, m), the p = m + 
 parameters of the paper's Eq. (28); the design region is the workspace's shape.
 
 Modules, each importing only from those before it: ``terms`` (per-pose terms
-of the design model), ``constraints``, ``criteria``, ``order`` (visiting
-order), ``exchange`` (discrete exchange), ``nlp`` (continuous design, Ipopt),
-``optimize`` (driver, :func:`optimize_design`), ``verify`` (Monte Carlo) and
-``plot``.  The public API is re-exported here.
+of the design model), ``regions`` (the reachable set, clipped: issue 13;
+imported lazily by ``constraints``), ``constraints``, ``criteria``, ``order``
+(visiting order), ``exchange`` (discrete exchange), ``nlp`` (continuous
+design, Ipopt), ``approx`` (approximate designs with certificates, rounding,
+fewest poses for a target CRLB: issue 13), ``optimize`` (driver,
+:func:`optimize_design`), ``verify`` (Monte Carlo) and ``plot``.  The public
+API is re-exported here.
 """
 from zerocal_sym.design.terms import design_params, pose_terms
-from zerocal_sym.design.constraints import (MAX_K, MIN_K, SCALE_RANGE_MM, TRAVEL_MODES, Constraints, CylinderRegion,
+from zerocal_sym.design.constraints import (MAX_K, MAX_K_EXACT, MIN_K, SCALE_RANGE_MM, TRAVEL_MODES, Constraints, CylinderRegion,
                                             DesignError, Region, check_design, make_constraints, make_region, min_k,
                                             workspace_region)
-from zerocal_sym.design.criteria import CRITERIA, criteria_table, criterion_values, evaluate
+from zerocal_sym.design.criteria import CRITERIA, criteria_table, criterion_values, evaluate, position_report
 from zerocal_sym.design.order import best_order
 from zerocal_sym.design.exchange import candidate_grid, exchange_design
 from zerocal_sym.design.nlp import PSD_FORM, continuous_design
-from zerocal_sym.design.optimize import DesignResult, boundary_baseline, optimize_design, paper_baseline
+from zerocal_sym.design.regions import Box, Polygon, ReachableRegion, make_reachable
+from zerocal_sym.design.approx import (APPROX_CRITERIA, ApproxDesign, approximate_design, efficient_rounding,
+                                       fewest_poses, realize)
+from zerocal_sym.design.optimize import (EXACT_MAX_K, DesignResult, boundary_baseline, choose_baseline,
+                                         optimize_design, paper_baseline)
 from zerocal_sym.design.verify import default_true_errors, verify_design
 from zerocal_sym.design.plot import plot_design
 
 __all__ = [
-    "CRITERIA", "MAX_K", "MIN_K", "PSD_FORM", "SCALE_RANGE_MM", "TRAVEL_MODES",
-    "Constraints", "CylinderRegion", "DesignError", "DesignResult", "Region",
-    "best_order", "boundary_baseline", "candidate_grid", "check_design", "continuous_design", "criteria_table",
-    "criterion_values", "default_true_errors", "design_params", "evaluate", "exchange_design",
-    "make_constraints", "make_region", "min_k", "optimize_design", "paper_baseline", "plot_design",
-    "pose_terms", "verify_design", "workspace_region",
+    "APPROX_CRITERIA", "CRITERIA", "EXACT_MAX_K", "MAX_K", "MAX_K_EXACT", "MIN_K", "PSD_FORM", "SCALE_RANGE_MM",
+    "TRAVEL_MODES",
+    "ApproxDesign", "Box", "Constraints", "CylinderRegion", "DesignError", "DesignResult", "Polygon",
+    "ReachableRegion", "Region",
+    "approximate_design", "best_order", "boundary_baseline", "candidate_grid", "check_design", "choose_baseline",
+    "continuous_design", "criteria_table", "criterion_values", "default_true_errors", "design_params",
+    "efficient_rounding", "evaluate", "exchange_design", "fewest_poses", "make_constraints", "make_reachable",
+    "make_region", "min_k", "optimize_design", "paper_baseline", "plot_design", "pose_terms", "position_report",
+    "realize", "verify_design", "workspace_region",
 ]

@@ -135,6 +135,7 @@ class PoseModel:
         t = pose_terms(robot, self.X)
         self.aq = t["a"] * _qscale(robot)
         self.vt = sx2 * np.sum(t["dth"] ** 2, axis=1) + sm2 / 4.0
+        self.vt = np.maximum(self.vt, 1e-12 * max(float(self.vt.max()), 1e-300))
         self.rho = t["rho"]
         self.criterion = criterion
         wts = weights or Weights(robot)
@@ -321,7 +322,7 @@ def _restricted(criterion, W, q, R, w0, tol=1e-13, max_iter=200):
     return w
 
 
-def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, q=E_Q):
+def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, q=E_Q, certify=True):
     """Optimal measure on the candidates of ``model`` for a concave criterion.
 
     A few multiplicative steps from ``w0`` find the rough support; then an
@@ -376,8 +377,8 @@ def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, 
             w[act] = _restricted(criterion, W, qq, _regressors(aq[act], vt[act]), wa / wa.sum())
     loss, grad, d, s, M, c = _evaluate(criterion, W, qs[-1], w, aq, vt)
     out = {"w": w, "M": M, "c": c, "d": d, "loss": loss, "s": s, "iterations": rounds, "q": qs[-1]}
-    if criterion == "E":
-        out["eff_lb"], out["E_bound"] = e_certificate(model, M, c)
+    if criterion == "E":  # the E-certificate (a small optimisation) only when asked; else the smooth one's
+        out["eff_lb"], out["E_bound"] = e_certificate(model, M, c) if certify else (float(s / d.max()), None)
     else:
         out["eff_lb"] = float(s / d.max())
     return out
@@ -673,13 +674,13 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     exact, enlarged = _windows(model.rho, cons)
     iters = 0
 
-    def solve_in(mod, win, w0=None, tol_=tol):
+    def solve_in(mod, win, w0=None, tol_=tol, certify=True):
         idx = np.flatnonzero((mod.rho >= win[0]) & (mod.rho <= win[1]))
         if len(idx) < p + 1:
             return idx, None
         sub = mod.subset(idx)
         try:
-            sol = solve_measure(sub, criterion, None if w0 is None else w0[idx], tol_)
+            sol = solve_measure(sub, criterion, None if w0 is None else w0[idx], tol_, certify=certify)
         except DesignError:
             return idx, None
         return idx, sol
@@ -690,7 +691,7 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     # the best exact window (coarse)
     best = None
     for win in exact:
-        idx, sol = solve_in(model, win, tol_=max(tol, 1e-2) if len(exact) > 1 else tol)
+        idx, sol = solve_in(model, win, tol_=max(tol, 1e-2) if len(exact) > 1 else tol, certify=False)
         if sol is None:
             continue
         iters += sol["iterations"]
@@ -716,8 +717,10 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         idx = np.flatnonzero((model.rho >= win[0]) & (model.rho <= win[1]))
         w0 = w0[idx]
         w0 = 0.9 * w0 / w0.sum() + 0.1 / len(w0)
-        sol = solve_measure(model.subset(idx), criterion, w0, tol)
+        sol = solve_measure(model.subset(idx), criterion, w0, tol, certify=r == refine - 1)
         iters += sol["iterations"]
+    if criterion == "E" and sol.get("E_bound") is None:
+        sol["eff_lb"], sol["E_bound"] = e_certificate(model.subset(idx), sol["M"], sol["c"])
     # the bound over every window (enlarged windows cover all l0-windows)
     if len(enlarged) == 1:
         bound_loss = _loss_bound(criterion, sol)
@@ -953,15 +956,16 @@ def _mse_terms(robot, X, noise, tolerances):
     sq = np.sqrt(vt)[:, None]
     Gt = np.column_stack([np.ones(len(vt)), t["a"] * _qscale(robot)]) / sq
     Go = (t["ao"] * wts.tol) / sq
-    return Gt, Go, np.concatenate([[0.0], wts.crlb])
+    return Gt, Go, np.concatenate([[0.0], wts.crlb]), wts.bias_model
 
 
-def _mse_value_grad(w, Gt, Go, wd, K):
+def _mse_value_grad(w, Gt, Go, wd, K, model="rms"):
     """Mean squared offset error (rad^2) of the pose model at mass K, and its gradient in ``w``.
 
     ``MSE = tr(W T) / K + tr(W B B^T)`` with ``T = N_tt^-1`` and the bias
     ``B = T N_to`` (per RMS tolerance); ``d/dw_x = -u^T W u / K + 2 u^T W B e``
-    (``u = T g_t``, ``e = g_o - B^T g_t``).
+    (``u = T g_t``, ``e = g_o - B^T g_t``).  ``model="worst"``: the bias term
+    is ``sum_j W_j (sum_k |B_jk|)^2`` (per tolerance).
     """
     Ntt = (Gt.T * w) @ Gt
     Nto = (Gt.T * w) @ Go
@@ -970,9 +974,14 @@ def _mse_value_grad(w, Gt, Go, wd, K):
     except np.linalg.LinAlgError:
         return math.inf, None
     B = T @ Nto
-    val = float(np.sum(wd * np.diag(T))) / K + float(np.sum(wd[:, None] * B ** 2))
     U = Gt @ T
     E = Go - Gt @ B
+    if model == "worst":
+        sB = np.sum(np.abs(B), axis=1)
+        val = float(np.sum(wd * np.diag(T))) / K + float(np.sum(wd * sB ** 2))
+        grad = -np.sum(U * U * wd, axis=1) / K + 2 * np.sum((U * (wd * sB)) @ np.sign(B) * E, axis=1)
+        return val, grad
+    val = float(np.sum(wd * np.diag(T))) / K + float(np.sum(wd[:, None] * B ** 2))
     grad = -np.sum(U * U * wd, axis=1) / K + 2 * np.sum((U * wd) @ B * E, axis=1)
     return val, grad
 
@@ -992,17 +1001,17 @@ def mse_measure(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None
 
     noise = noise or NoiseModel.paper()
     X = ad.X
-    Gt, Go, wd = _mse_terms(robot, X, noise, tolerances)
+    Gt, Go, wd, model = _mse_terms(robot, X, noise, tolerances)
     w = np.maximum(ad.w, 0) + 1e-6 / len(ad.w)
     w /= w.sum()
-    f, g = _mse_value_grad(w, Gt, Go, wd, K)
+    f, g = _mse_value_grad(w, Gt, Go, wd, K, model)
     eta = 1.0
     for _ in range(max_iter):
         gn = (g - w @ g) / max(abs(f), 1e-300)
         while True:
             wn = w * np.exp(-eta * np.clip(gn, -50, 50))
             wn /= wn.sum()
-            fn, gg = _mse_value_grad(wn, Gt, Go, wd, K)
+            fn, gg = _mse_value_grad(wn, Gt, Go, wd, K, model)
             if gg is not None and fn <= f - 1e-4 * eta * float(w @ (gn * (g - w @ g))):
                 break
             eta *= 0.5

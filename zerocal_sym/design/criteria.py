@@ -44,8 +44,10 @@ Criteria (all minimised internally as a log)
     ``sqrt(mean_i (CRLB_i^2 + E[b_i^2]))`` in degrees (minimised): the RMS
     error of the m zero offsets including the first-order bias ``b`` from the
     source errors the model leaves out, each uniform within its tolerance
-    (:mod:`zerocal_sym.identify.bias`; ``E[b_i^2] = sum_j S_ij^2 t_j^2 / 3``).
-    The bias does not shrink with K; the variance does.
+    (:mod:`zerocal_sym.identify.bias`; ``E[b_i^2] = sum_j S_ij^2 t_j^2 / 3``);
+    with the ``worst`` bias model (:class:`zerocal_sym.identify.bias.Tolerances`)
+    the squared worst case ``(sum_j |S_ij| t_j)^2`` instead.  The bias does
+    not shrink with K; the variance does.
 
 ``position`` and ``mse`` take :class:`zerocal_sym.design.terms.Weights`
 (the position weight, the tolerances); ``mse`` works on the sensitivities
@@ -228,7 +230,8 @@ def _objective_fisher(criterion, F, w):
             out[ok] = np.log(np.einsum("ij,bji->b", wt.position, Finv))
         elif criterion == "mse":
             Bm = Finv @ H[ok]
-            out[ok] = np.log((np.diagonal(Finv, axis1=1, axis2=2) + np.sum(Bm ** 2, axis=2)) @ wc)
+            b2 = np.sum(np.abs(Bm), axis=2) ** 2 if wt.bias_model == "worst" else np.sum(Bm ** 2, axis=2)
+            out[ok] = np.log((np.diagonal(Finv, axis1=1, axis2=2) + b2) @ wc)
         else:
             raise DesignError(f"unknown criterion {criterion!r}")
     return out

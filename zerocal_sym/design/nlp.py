@@ -76,10 +76,12 @@ class _NLP:
         import casadi as ca
 
         self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
+        self._need_B, self.wts = False, None
         sm2, sx2 = _noise_terms(noise)
         qs = _qscale(robot)
         wc = _crlb_weights(robot)
         wts = Weights(robot, tolerances) if criterion in ("position",) + EXTENDED else None
+        self.wts = wts
         dim, p = robot.n, len(qs)  # pose coordinates, parameters
         psd_form = psd_form or _psd_form(criterion, p)
         self.n = dim
@@ -203,7 +205,23 @@ class _NLP:
                                      if Wp[i, j] != 0))
                 elif criterion in EXTENDED:  # variance + squared bias; Finv = fscale F^-1, bias = F^-1 H
                     Bm = Finv @ (Hx / fscale)
-                    obj = ca.log(sum(float(wc[j]) * (Finv[j, j] + fscale * ca.sumsqr(Bm[j, :]))
+                    if wts.bias_model == "worst":  # (sum_k |B_jk|)^2 by an epigraph: -u <= B <= u, smooth
+                        rows = [j for j in range(p) if wc[j] != 0]
+                        r_ = Bm.shape[1]
+                        ub = ca.SX.sym("ub", len(rows), r_)
+                        Bsel = ca.vertcat(*[Bm[j, :] for j in rows])
+                        add(ca.vec(ub - Bsel), 0, np.inf)
+                        add(ca.vec(ub + Bsel), 0, np.inf)
+                        aux.append(("bias bound", ca.vec(ub), 0.0, np.inf,
+                                    lambda n, rows=rows: (np.abs(n["B"][rows]) * (1 + 1e-6)
+                                                          + 1e-12).ravel(order="F")))
+                        self._need_B = True
+                        b2 = [0] * p
+                        for i_, j in enumerate(rows):
+                            b2[j] = ca.sum2(ub[i_, :]) ** 2
+                    else:
+                        b2 = [ca.sumsqr(Bm[j, :]) for j in range(p)]
+                    obj = ca.log(sum(float(wc[j]) * (Finv[j, j] + fscale * b2[j])
                                      for j in range(p) if wc[j] != 0))
                 else:
                     obj = ca.log(sum(float(wc[j]) * Finv[j, j] for j in range(p) if wc[j] != 0))
@@ -241,6 +259,14 @@ class _NLP:
                 "Fn": _fisher_batch(aq[None], v[None], self.sm2)[0] / self.fscale}
         nums["wM"] = np.linalg.eigvalsh(nums["M"])
         nums["wF"] = np.linalg.eigvalsh(nums["Fn"])
+        if self._need_B:  # the bias per tolerance of the start (q-units), for the epigraph bounds
+            ext = self.wts.extend(aq, t["ao"])
+            Fe = _fisher_batch(ext[None], v[None], self.sm2)[0]
+            p_ = aq.shape[1]
+            try:
+                nums["B"] = np.linalg.solve(Fe[:p_, :p_], Fe[:p_, p_:])
+            except np.linalg.LinAlgError:
+                nums["B"] = np.ones((p_, ext.shape[1] - p_))
         aux = [np.atleast_1d(a_[4](nums)) for a_ in self.aux]
         return np.concatenate([z0.ravel()] + aux)  # z is (n, K) column-major == P0 (K, n) row-major
 

@@ -174,15 +174,22 @@ def _position_weight(robot):
 
 
 def _tolerance_columns(robot, tolerances):
-    """Scale of the omitted-error sensitivities for the bias: ``t_j / sqrt(3)`` (RMS of a uniform error), shape (r,).
+    """Scale of the omitted-error sensitivities for the bias, shape (r,).
 
-    ``tolerances``: dict name -> value (internal units) or None for the defaults
-    (:func:`zerocal_sym.identify.bias.default_tolerances`).
+    ``t_j / sqrt(3)`` (the RMS of a uniform error) for the ``rms`` bias model,
+    ``t_j`` for ``worst`` (:class:`zerocal_sym.identify.bias.Tolerances`).
+    ``tolerances``: dict name -> value (internal units) or None for the
+    defaults (:func:`zerocal_sym.identify.bias.default_tolerances`).
     """
     from zerocal_sym.identify import bias
 
     tol = bias.default_tolerances(robot) if tolerances is None else tolerances
-    return bias.tolerance_vector(robot, tol, omitted_params(robot)) / np.sqrt(3.0)
+    t = bias.tolerance_vector(robot, tol, omitted_params(robot))
+    return t if _bias_model(tolerances) == "worst" else t / np.sqrt(3.0)
+
+
+def _bias_model(tolerances):
+    return getattr(tolerances, "bias_model", "rms")
 
 
 class Weights:
@@ -195,7 +202,8 @@ class Weights:
     position : ndarray, shape (p, p)
         :func:`_position_weight`.
     tol : ndarray, shape (r,)
-        RMS of each omitted error (``t / sqrt(3)``), internal units.
+        RMS of each omitted error (``t / sqrt(3)``; ``t`` for the worst case), internal units.
+    bias_model : {"rms", "worst"}
     p, r : int
     """
 
@@ -203,6 +211,7 @@ class Weights:
         self.crlb = _crlb_weights(robot)
         self.position = _position_weight(robot)
         self.tol = _tolerance_columns(robot, tolerances)
+        self.bias_model = _bias_model(tolerances)
         self.p, self.r = len(self.crlb), len(self.tol)
 
     def extend(self, aq, ao):

@@ -58,6 +58,27 @@ MECHANISM_TOLERANCES = {
 RMS_MODEL = "independent uniform errors in [-t, t] (variance t^2/3)"
 
 
+#: how the ``mse`` design criterion counts the bias (:class:`Tolerances`)
+BIAS_MODELS = ("rms", "worst")
+
+
+class Tolerances(dict):
+    """Tolerances by name (internal units) and how a design criterion counts the bias from them.
+
+    ``bias_model``: ``"rms"`` -- the expected squared bias for errors uniform
+    within the tolerances, ``sum_j S_ij^2 t_j^2 / 3`` (the mean squared error
+    averaged over such robots); ``"worst"`` -- the squared worst case
+    ``(sum_j |S_ij| t_j)^2`` (a bound for every robot within the tolerances,
+    e.g. a corner of the tolerance box such as Table 2's set A).
+    """
+
+    def __init__(self, values=(), bias_model: str = "rms"):
+        super().__init__(values)
+        if bias_model not in BIAS_MODELS:
+            raise ZerocalError(f"unknown bias model {bias_model!r} (known: {', '.join(BIAS_MODELS)})")
+        self.bias_model = bias_model
+
+
 def omitted(robot, params="paper") -> tuple:
     """The source errors a fit of ``params`` holds at zero, in the mechanism's order."""
     keep = set(robot.errors.resolve(params))
@@ -83,7 +104,8 @@ def default_tolerances(robot, params="paper") -> dict:
     return out
 
 
-def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="paper", defaults: bool = True) -> dict:
+def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="paper", defaults: bool = True,
+                    bias_model: str = "rms") -> "Tolerances":
     """Tolerances of the omitted errors by name (internal units): defaults, a file, ``NAME=VALUE`` items, a scale.
 
     Parameters
@@ -97,6 +119,8 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
         Every tolerance multiplied by this (e.g. 10).
     defaults : bool
         Start from :func:`default_tolerances` (else from zero).
+    bias_model : {"rms", "worst"}
+        How the ``mse`` design criterion counts the bias (:class:`Tolerances`).
 
     Raises
     ------
@@ -131,7 +155,7 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
         raise ZerocalError(f"tolerance scale {scale!r}: not a number") from None
     if not math.isfinite(scale) or scale < 0:
         raise ZerocalError(f"tolerance scale must be finite and >= 0, got {scale!r}")
-    return {n: tol[n] * scale for n in names}
+    return Tolerances({n: tol[n] * scale for n in names}, bias_model)
 
 
 def _read_file(path) -> dict:
