@@ -44,6 +44,13 @@ class BatchResult:
         Confirmed in the batch (False: handed to the single path).
     chi2 : ndarray, shape (N,)
         Sum of squared whitened residuals.
+    dof : int
+        Degrees of freedom of ``chi2`` (K - 1 - p).
+    p_value : ndarray, shape (N,)
+        The fit check's p-value ``P(chi2_dof >= chi2)``
+        (:func:`zerocal_sym.identify.fitcheck.chi2_sf`; NaN where not
+        available).  The batch does not reject: ``success`` means converged;
+        compare ``p_value`` with a level (the single path's default 0.001).
     """
 
     params: tuple
@@ -52,6 +59,8 @@ class BatchResult:
     success: np.ndarray
     confirmed: np.ndarray
     chi2: np.ndarray
+    dof: int = 0
+    p_value: np.ndarray | None = None
 
     def values(self, names) -> np.ndarray:
         """Columns of the estimate by name, shape (N, len(names))."""
@@ -152,10 +161,17 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
     success = confirmed.copy()
     for k in np.flatnonzero(~confirmed):  # the single path decides
         res = identify_nlls(robot, Measurements(theta_cmd=theta_cmd, readings=readings[k]), names, noise=noise,
-                            prior=prior_q)
+                            prior=prior_q, fit_alpha=0.0)  # no rejection here: p_value below
         if res.success:
             est[k] = res.estimate
             std[k] = [res.std(nm) for nm in names]
             chi2[k] = res.info["chi2"]
             success[k] = True
-    return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed, chi2=chi2)
+    from zerocal_sym.identify.fitcheck import chi2_sf
+
+    dof = K - 1 - p
+    pv = np.full(N, np.nan)
+    if dof > 0 and not noise.is_zero:
+        pv = np.array([chi2_sf(c, dof) if np.isfinite(c) else np.nan for c in chi2])
+    return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed, chi2=chi2,
+                       dof=dof, p_value=pv)

@@ -44,7 +44,7 @@ import time
 
 import numpy as np
 
-from zerocal_sym.identify import fisher
+from zerocal_sym.identify import fisher, fitcheck
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.identify.nlls_problem import get_problem
@@ -59,6 +59,8 @@ CONVERGED_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 RANK_RTOL = 1e-9
 #: Gauss-Newton is converged when its last step is below this (scaled units, mm)
 GN_STEP_TOL = 1e-8
+#: losses of identify_nlls (robust ones: zerocal_sym.identify.robust)
+LOSSES = ("l2", "huber", "soft_l1")
 
 
 def _as_vector(x, n, what):
@@ -120,7 +122,8 @@ def _initial(robot, meas, names, prior_q, warm_start):
 
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
                   bounds=None, prior_std=None, warm_start=None, reweight: int = 1,
-                  max_iter: int | None = None, prior_cov=None) -> IdentificationResult:
+                  max_iter: int | None = None, prior_cov=None, loss: str = "l2", loss_scale: float | None = None,
+                  fit_alpha: float = fitcheck.DEFAULT_ALPHA, accept_misfit: bool = False) -> IdentificationResult:
     """Maximum-likelihood (or MAP) identification with Ipopt on the exact model.
 
     Parameters
@@ -156,6 +159,29 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         so the answer is their fixed point; 0: held at the start point.
     max_iter : int, optional
         Ipopt iteration limit (default 200).
+    loss : {"l2", "huber", "soft_l1"}
+        ``l2`` (default): the Gaussian likelihood, solved as below.  A robust
+        loss starts from the l2 solution and runs iteratively reweighted
+        Gauss-Newton on the exact model (:mod:`zerocal_sym.identify.robust`:
+        each reading judged by its conditional residual given the others, so
+        the servo error's correlation does not spread a bad reading).
+        Readings whose weight ends below
+        :data:`~zerocal_sym.identify.fitcheck.ROBUST_EXCLUDE_WEIGHT` are
+        outliers: named in the status, the estimate refitted without them
+        (its covariance that of the readings kept), left out of the fit
+        check.  Otherwise the covariance is the inverse of the information
+        with the final weights.  Not with ``bounds``.
+    loss_scale : float, optional
+        Where the robust loss turns from quadratic to linear, in standard
+        deviations of a reading's conditional residual (default 1.345 for
+        huber, 1.0 for soft_l1).
+    fit_alpha : float
+        The fit check's level (:mod:`zerocal_sym.identify.fitcheck`): a fit
+        with ``p < fit_alpha`` is rejected (``success`` False, status
+        ``"rejected: ..."``).  Default 0.001.
+    accept_misfit : bool
+        Keep a fit the check rejects as a calibration (status "accepted
+        despite misfit ...").
 
     Solution: ``N_GN`` damped Gauss-Newton iterations inside one CasADi
     call (:mod:`zerocal_sym.identify.nlls_problem`), then one Ipopt solve from
@@ -168,13 +194,28 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     -------
     IdentificationResult
         ``method = "nlls"``; ``success`` False whenever Ipopt did not
-        converge (``status`` says why); ``info``: ``solver_status``,
-        ``iterations``, ``cost``, ``time_s``, ``weighting``, ``warm_start``,
-        ``rank``, ``singular_values`` (of the scaled whitened Jacobian),
-        ``nonidentifiable``.
+        converge (``status`` says why) and when the fit check rejects the fit;
+        ``info``: ``solver_status``, ``iterations``, ``cost``, ``chi2``,
+        ``dof``, ``time_s``, ``weighting``, ``warm_start``, ``rank``,
+        ``singular_values`` (of the scaled whitened Jacobian),
+        ``nonidentifiable``, ``fit`` (the fit check), ``robust`` (with a
+        robust loss).  ``std_kind``: ``"total"`` (the Cramér-Rao bound at the
+        estimate: the exact model has no linearisation bias) or ``"from
+        residuals"`` (zero noise model).
     """
     t0 = time.perf_counter()
     noise = NoiseModel.paper() if noise is None else noise
+    if loss not in LOSSES:
+        raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
+    delta = None
+    if loss != "l2":
+        from zerocal_sym.identify.robust import DEFAULT_SCALE
+
+        delta = DEFAULT_SCALE[loss] if loss_scale is None else float(loss_scale)
+        if not delta > 0:
+            raise ValueError(f"loss_scale must be positive, got {loss_scale!r}")
+        if bounds is not None:
+            raise ValueError("a robust loss does not take bounds")
     errors = robot.errors
     names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
@@ -246,6 +287,28 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         l, b = (np.array(o) for o in fast["weights"](z if reweight else z0, par))
         r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
     r, rp, pred = r.ravel(), rp.ravel(), pred.ravel()
+    robust = None
+    if loss != "l2":  # from the l2 solution, or from the prior when Ipopt failed (an outlier can cause that)
+        z_start = z if (converged and np.all(np.isfinite(z))) else mu * scale
+        z, robust, ok = _robust(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta, w, K)
+        robust["l2_solver_status"] = ret
+        if not ok:
+            converged, ret = False, "robust iteration did not converge"
+        elif not converged:
+            converged, ret = True, f"robust iteration converged; the l2 Ipopt solve: {ret}"
+        p_hat = z / scale
+        l, b = (np.array(o) for o in fast["weights"](z, par))
+        r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
+        r, rp, pred = r.ravel(), rp.ravel(), pred.ravel()
+        A = -(np.diag(l.ravel()) + np.diag(np.ravel(b), -1)) @ J[: K - 1]   # d pred / d z
+        excl = np.asarray(robust["excluded_readings"], int) - 1
+        if robust["refit_without_outliers"]:  # information of the readings kept
+            keep = np.setdiff1d(np.arange(K - 1), excl)
+            Jk = np.zeros((K - 1, len(names)))
+            Jk[: keep.size] = np.linalg.solve(np.linalg.cholesky(robust["_C"][np.ix_(keep, keep)]), -A[keep])
+        else:  # information with the final robust weights: the data rows whitened by chol(C_w)
+            Jk = np.linalg.solve(np.linalg.cholesky(robust["_C_w"]), -A)
+        J = np.vstack([Jk, J[K - 1:]])
     Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
     # F = J^T J (data + prior information, scaled units) from one SVD of J: F = V diag(sJ^2) V^T
     _, sJ, Vt = np.linalg.svd(J, full_matrices=False)
@@ -284,13 +347,18 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                   "not identifiable (see info['nonidentifiable'])")
     else:
         status = f"converged ({ret})"
+    if robust is not None and robust["excluded_readings"]:
+        status += (f"; {loss} loss: reading(s) at pose {', '.join(map(str, robust['excluded_readings']))} "
+                   "down-weighted as outliers (estimated error " +
+                   ", ".join(f"{e:+.3g} mm" for e in robust["excluded_errors_mm"]) + ")" +
+                   ("; estimate refitted without them" if robust["refit_without_outliers"] else ""))
     info = {
         "solver_status": ret,
         "iterations": total_iter,
         "cost": 0.5 * float(r @ r + rp @ rp),
         "chi2": float(r @ r),
         "dof": (K - 1) - len(names),
-        "time_s": time.perf_counter() - t0,
+        "time_s": None,
         "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
                       "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"),
         "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
@@ -302,10 +370,97 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "nonidentifiable": nonid,
         "scale_mm_per_unit": scale.tolist(),
         "prior": prior_q.tolist(),
+        "loss": loss,
     }
-    return IdentificationResult(method="nlls", params=names, estimate=p_hat,
-                                covariance=cov, success=bool(success), status=status,
-                                residuals=np.asarray(s - pred), info=info, errors=errors)
+    if np.any(w):
+        info["prior_whitener"] = w.tolist()
+    res = IdentificationResult(method="nlls", params=names, estimate=p_hat,
+                               covariance=cov, success=bool(success), status=status,
+                               residuals=np.asarray(s - pred), info=info, errors=errors,
+                               std_kind="from residuals" if noise.is_zero else "total")
+    # the fit check: whitened exact-model residuals at the estimate against the noise model
+    rows = np.flatnonzero(np.any(w != 0, axis=1))
+    if robust is None:
+        lin = fitcheck._Linear(np.concatenate([r, rp[rows]]), np.vstack([Jd, J[K - 1:][rows]]),
+                               fitcheck.band_whitener(l, b), np.arange(1, K), s - pred, np.eye(len(names)),
+                               scale, names, len(rows))
+        at = "estimate"
+    else:
+        lin = _robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
+        at = ("estimate, without the readings the robust loss down-weighted (at pose "
+              f"{', '.join(map(str, robust['excluded_readings']))})" if robust["excluded_readings"] else "estimate")
+        info["robust"] = {k: v for k, v in robust.items() if not k.startswith("_")}
+    tol_b = 1e-7 * (1.0 + np.abs(z))
+    active = [n for n, zz, lo, hi, tb in zip(names, z, lbx, ubx, tol_b) if zz <= lo + tb or zz >= hi - tb]
+    fitcheck.check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
+                          prior_whitener=w if np.any(w) else None, evaluated_at=at, active_bounds=active)
+    info["time_s"] = time.perf_counter() - t0
+    return res
+
+
+def _robust(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delta, w, K):
+    """Robust stage (:mod:`zerocal_sym.identify.robust`).
+
+    Candidates: IRLS from the l2 solution; IRLS from the best exact fit
+    without one reading (a large outlier drags the l2 solution far along a
+    weak direction); that deletion fit itself, if the loss down-weights the
+    reading it left out there (an outlier with high leverage drags IRLS off
+    it: Huber's loss bounds a reading's influence, not its leverage).  The
+    readings a candidate down-weights below ROBUST_EXCLUDE_WEIGHT are its
+    outliers, and its estimate is the exact fit without them.  Between
+    candidates: one whose fit without its outliers passes the fit check, then
+    the fewest outliers, then the lower robust objective.
+
+    Returns ``(z, info, converged)``.
+    """
+    from zerocal_sym.identify import robust as rb
+
+    pw = w if np.any(w) else None
+    args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
+    cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
+    if K - 2 > len(names):
+        drop = fitcheck.refits(*args, [[j] for j in range(K - 1)], z_l2, prior_whitener=pw)
+        if np.any(np.isfinite(drop["chi2"])):
+            j = int(np.argmin(drop["chi2"]))
+            cands += [(drop["z"][j], None), (drop["z"][j], j)]
+    best = None
+    for z0, j in cands:
+        out = rb.irls(*args, z0, loss, delta, prior_whitener=pw, max_iter=100 if j is None else 0)
+        if j is None:
+            excl = np.flatnonzero(out["weights"] < fitcheck.ROBUST_EXCLUDE_WEIGHT)
+        else:  # the best single deletion itself (an outlier with high leverage drags IRLS off it)
+            excl = np.array([j]) if out["weights"][j] < fitcheck.ROBUST_EXCLUDE_WEIGHT else np.zeros(0, int)
+            out["converged"] = True
+        ref = fitcheck.refits(*args, [excl], out["z"], prior_whitener=pw, max_iter=50 if excl.size else 0,
+                              tol=GN_STEP_TOL)
+        c, d = float(ref["chi2"][0]), int(ref["dof"][0])
+        passes = bool(d > 0 and np.isfinite(c) and fitcheck.chi2_sf(c, d) >= fitcheck.DEFAULT_ALPHA)
+        key = (bool(out["converged"]), passes, -excl.size, -out["objective"])
+        if best is None or key > best[0]:
+            best = (key, out, excl, ref)
+    _, out, excl, ref = best
+    z, ok = out["z"], out["converged"]
+    C, refit = out["C"], False
+    err_mm = out["conditional_residual_mm"][excl]
+    if ok and excl.size and ref["converged"][0]:  # the outliers named: the estimate is the exact fit without them
+        z, refit = ref["z"][0], True
+        e, _, C = rb._Model(robot, theta_cmd, meas.readings, names, prior_q, noise, pw).at(z)
+        err_mm = rb.conditional_residuals(e, C, np.zeros(K - 1))[0][excl]
+    return z, {
+        "loss": loss, "scale_sigmas": float(delta), "iterations": int(out["iterations"]),
+        "converged": bool(ok), "weights": out["weights"].tolist(), "standardised": out["u"].tolist(),
+        "excluded_readings": [int(j) + 1 for j in excl], "excluded_errors_mm": [float(v) for v in err_mm],
+        "refit_without_outliers": refit, "_C": C, "_C_w": out["C_w"],
+    }, ok
+
+
+def _robust_linear(robust, e, A, Jp, rp, scale, names, K):
+    """The fit check's problem of a robust fit: the readings it down-weighted removed (by marginalising C)."""
+    keep = np.setdiff1d(np.arange(K - 1), np.asarray(robust["excluded_readings"], int) - 1)
+    C = robust["_C"][np.ix_(keep, keep)]
+    W = np.linalg.solve(np.linalg.cholesky(C), np.eye(keep.size))
+    return fitcheck._Linear(np.concatenate([W @ e[keep], rp]), np.vstack([W @ -A[keep], Jp]), W, keep + 1, e[keep],
+                            np.eye(len(names)), scale, names, len(rp))
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):

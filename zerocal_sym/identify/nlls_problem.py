@@ -191,10 +191,6 @@ class NllsProblem:
                                  ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])
         self._nlp, self._solvers = nlp, {}
         self._batch = {}
-        # symbols kept for the robust-loss problem (built on first use, see robust())
-        self._sym = {"z": z, "par": par, "pred": pred, "dth2": dth2, "pz": pz, "w": w, "mu": mu, "s": s,
-                     "sm2": sm2, "sx2": sx2}
-        self._robust = {}
         # zero-copy callers of the functions identify_nlls calls every time
         self.fast = {name: FastCall(getattr(self, name))
                      for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun")}

@@ -39,6 +39,14 @@ class IdentificationResult:
     errors : SourceErrors or None
         The mechanism's source errors (names, roles, units); set by the
         identification.  Needed for :meth:`full_vector` and the role views.
+    std_kind : str
+        What the standard deviations include: ``"total"`` (every error the
+        method knows of: the noise through the model, and for TSVD its
+        linearisation bias and the truncated directions' bias bound),
+        ``"from residuals"`` (no noise model: the noise level estimated from
+        the residuals), ``"lower bound"`` (a known contribution could not be
+        evaluated; ``info`` says which).  Unmodelled source errors are in none
+        of them: the fit check (``info["fit"]``) is the guard against those.
     """
 
     method: str
@@ -50,6 +58,7 @@ class IdentificationResult:
     residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
     info: dict = field(default_factory=dict)
     errors: object = field(default=None, repr=False)
+    std_kind: str = "total"
 
     def value(self, name: str, default=0.0) -> float:
         """Estimate of one parameter by name (``default`` if not identified)."""
@@ -108,4 +117,23 @@ class IdentificationResult:
             "covariance": None if self.covariance is None else self.covariance.tolist(),
             "covariance_units": "rad for angles, mm otherwise (SI-like internal units)",
             "residuals_mm": np.asarray(self.residuals).tolist(),
+            "std_kind": self.std_kind,
+            "fit": _json_ready(self.info.get("fit")) if isinstance(self.info, dict) else None,
         }
+
+
+def _json_ready(obj):
+    """Plain Python (dicts, lists, floats, None for non-finite numbers) of a nested structure."""
+    if isinstance(obj, dict):
+        return {str(k): _json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_ready(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _json_ready(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if np.isfinite(obj) else None
+    return obj

@@ -186,7 +186,8 @@ def _validate(meas, robot, p):
             raise IdentificationError(f"{name} of pose {k} is not a finite number", where=meas.where(k))
 
 
-def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None, rtol=DEFAULT_RTOL):
+def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None, rtol=DEFAULT_RTOL,
+                  fit_alpha: float | None = None, accept_misfit: bool = False):
     """Identify zero offsets and MAEMM from one round of measurements by TSVD.
 
     The model is linearised at the prior: the nominal poses are
@@ -212,6 +213,13 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         the noise level of the discrepancy principle.
     rtol : float
         Threshold of the ``threshold`` rule.
+    fit_alpha : float, optional
+        Level of the fit check (:mod:`zerocal_sym.identify.fitcheck`, default
+        0.001): a fit with ``p < fit_alpha`` is rejected (``success`` False,
+        status ``"rejected: ..."``).  Without a noise model the fit cannot be
+        checked.
+    accept_misfit : bool
+        Keep a rejected fit as a calibration (status "accepted despite misfit").
 
     Returns
     -------
@@ -224,10 +232,21 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         ``T`` converting ``L dth`` to ``dth``.  Without a noise model it is
         ``s^2 T A A^T T`` with ``s^2 = ||r||^2 / (K - 1 - t)`` (white noise
         estimated from the linear residuals), or None if ``K - 1 = t``.
-        Truncation bias is not in the covariance.  ``residuals`` are the
-        measured minus the exact-model changes at the estimate.  ``info``:
-        ``singular_values``, ``truncation``, ``filter_factors``, ``rule``,
-        ``kappa``, ``linear_residuals``, ``increment``, ``nominal_poses``.
+        **What TSVD leaves out is added** (``std_kind = "total"``, or
+        ``"from residuals"`` without a noise model): the linearisation bias
+        ``b = estimate - (exact-model minimum over the kept directions, Gauss-
+        Newton from the estimate)`` as ``b b^T``, and for each truncated
+        direction ``v_i`` a bias bound ``(|c_i| + 2 sd_i)^2 T v_i v_i^T T``
+        (``c_i`` its component in the full-rank exact fit, ``sd_i`` that
+        component's std); if these cannot be evaluated the std is labelled
+        ``"lower bound"``.  ``info["covariance_noise"]`` is the noise part
+        alone, ``info["std_components"]`` the three parts per parameter.
+        ``residuals`` are the measured minus the exact-model changes at the
+        estimate.  ``info``: ``singular_values``, ``truncation``,
+        ``filter_factors``, ``rule``, ``kappa``, ``linear_residuals``,
+        ``increment``, ``nominal_poses``, ``linearisation_bias``, ``fit`` (the
+        fit check, at the exact-model minimum over the kept directions:
+        a test of the data, not of TSVD's linearisation).
 
     Raises
     ------
@@ -296,6 +315,8 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     status = f"ok: TSVD t = {sol.t} of {s.size} ({sol.rule})"
     if sol.t < s.size:
         status += "; truncated directions are not identified (biased estimate)"
+    honest = _honest_uncertainty(robot, meas, names, errors.put(errors.zeros(), names, errors.take(prior, names)),
+                                 noise, est, sol, cov)
     info = {
         "singular_values": sol.singular_values,
         "truncation": sol.t,
@@ -308,5 +329,98 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         "right_singular_vectors": sol.Vt,
         "maemm_prior": errors.take(prior, maemm),
     }
-    return IdentificationResult(method="tsvd", params=names, estimate=est, covariance=cov, success=True,
-                                status=status, residuals=residuals, info=info, errors=errors)
+    info.update({k: v for k, v in honest.items() if not k.startswith("_")})
+    res = IdentificationResult(method="tsvd", params=names, estimate=est, covariance=honest["_covariance"],
+                               success=True, status=status, residuals=residuals, info=info, errors=errors,
+                               std_kind=honest["_std_kind"])
+    from zerocal_sym.identify import fitcheck
+
+    exact = honest["_exact"]
+    lin = exact.linear(np.asarray(info["fit_point"]) * exact.scale, honest["_basis"])
+    fitcheck.check_result(robot, meas, res, lin, exact.noise, names, exact.prior_q,
+                          fitcheck.DEFAULT_ALPHA if fit_alpha is None else fit_alpha, accept_misfit,
+                          evaluated_at=honest["_evaluated_at"])
+    res.info["fit"]["chi2_at_estimate"] = honest["_chi2_at_estimate"]
+    return res
+
+
+def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_noise) -> dict:
+    """TSVD's covariance with what it leaves out: linearisation bias and truncated directions' bias bound.
+
+    Returns a dict: ``_covariance`` (total), ``_std_kind``, ``_exact`` (the exact
+    whitened model), ``_basis`` (kept directions, scaled), ``_evaluated_at``,
+    ``_chi2_at_estimate`` and the JSON-ready ``info`` entries
+    ``covariance_noise``, ``linearisation_bias``, ``truncation_bias_bound``,
+    ``std_components``, ``std_note``, ``fit_point``, ``fit_basis``, ``prior``, ``noise``.
+    """
+    from zerocal_sym.identify import fitcheck
+    from zerocal_sym.model.noise import NoiseModel
+
+    errors = robot.errors
+    nm = NoiseModel() if noise is None else noise
+    exact = fitcheck._Exact(robot, meas.theta_cmd, meas.readings, names, prior_eff, nm)
+    sc = exact.scale
+    p, t = len(names), sol.t
+    basis = sol.Vt[:t].T
+    z_est = est * sc
+    r_est = exact.evaluate(z_est)[0]
+    out = {"_exact": exact, "_basis": basis, "_chi2_at_estimate": float(r_est @ r_est),
+           "_std_kind": "total" if noise is not None else "from residuals",
+           "prior": prior_eff.tolist(), "noise": {"sigma_scale_mm": nm.sigma_scale_mm,
+                                                  "sigma_servo_rad": nm.sigma_servo_rad},
+           "fit_basis": basis.tolist(),
+           "covariance_noise": None if cov_noise is None else np.asarray(cov_noise).tolist()}
+    notes = []
+    b_lin = np.full(p, np.nan)
+    bound = np.zeros(p)
+    trunc = np.zeros((p, p))
+    z_ref = z_est
+    try:
+        z_ref = exact.refine(z_est, basis)
+        b_lin = est - z_ref / sc
+        if t < p:
+            z_full = exact.refine(z_ref, None)
+            lin = exact.linear(z_full)
+            Finv = np.linalg.pinv(lin.J.T @ lin.J)
+            if nm.is_zero:  # unit weights: the noise level from the residuals of the full fit
+                Finv = Finv * (float(lin.r @ lin.r) / lin.dof if lin.dof > 0 else np.nan)
+            for i in range(t, p):
+                v = sol.Vt[i]
+                c = float(v @ (z_full - z_ref))
+                bi = abs(c) + 2.0 * float(np.sqrt(max(v @ Finv @ v, 0.0)))
+                u = v / sc
+                trunc += bi**2 * np.outer(u, u)
+                bound = np.sqrt(bound**2 + (bi * u) ** 2)
+    except (FloatingPointError, np.linalg.LinAlgError, ValueError) as exc:
+        notes.append(f"the exact-model refinement failed ({exc}): the linearisation and truncation biases are not "
+                     "in the std")
+    if not (np.all(np.isfinite(b_lin)) and np.all(np.isfinite(trunc))):
+        out["_std_kind"] = "lower bound"
+        if not notes:
+            notes.append("the truncated directions' bias could not be bounded: it is not in the std")
+        b_lin = np.where(np.isfinite(b_lin), b_lin, 0.0)
+        trunc = np.where(np.isfinite(trunc), trunc, 0.0)
+        bound = np.where(np.isfinite(bound), bound, 0.0)
+    if cov_noise is None:
+        cov = None
+        out["_std_kind"] = "lower bound"
+        notes.append("no noise model and no spare degree of freedom: the noise part of the std is unknown")
+    else:
+        cov = np.asarray(cov_noise) + np.outer(b_lin, b_lin) + trunc
+    noise_sd = (np.sqrt(np.diag(cov_noise)) if cov_noise is not None else np.full(p, np.nan))
+    out["_covariance"] = cov
+    out["_evaluated_at"] = ("the exact-model minimum over TSVD's kept directions (Gauss-Newton from its estimate)"
+                            if np.any(z_ref != z_est) else "estimate")
+    out["fit_point"] = (z_ref / sc).tolist()
+    out["linearisation_bias"] = b_lin.tolist()
+    out["truncation_bias_bound"] = bound.tolist()
+    out["std_components"] = {
+        n: {"noise": None if not np.isfinite(noise_sd[k]) else errors.to_user_value(n, float(noise_sd[k])),
+            "linearisation_bias": errors.to_user_value(n, float(b_lin[k])),
+            "truncation_bias_bound": errors.to_user_value(n, float(bound[k])),
+            "unit": errors[n].user_unit}
+        for k, n in enumerate(names)}
+    out["std_note"] = ("; ".join(notes) if notes else
+                       "std = sqrt(noise^2 + linearisation bias^2 + truncation bias bound^2) per parameter "
+                       "(covariance: noise + b b^T + bound terms)")
+    return out
