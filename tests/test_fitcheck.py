@@ -340,7 +340,7 @@ def test_the_paper_loop_uses_and_counts_misfits(robot):
 
 
 # ------------------------------------------------------------------ plausibility
-def test_plausibility(robot):
+def test_plausibility(robot, tmp_path):
     e = robot.errors
 
     def result(offsets_deg, maemm, success=True):
@@ -356,6 +356,13 @@ def test_plausibility(robot):
     assert len(r) == 1 and "MAEMM" in r[0] and "50 mm" in r[0]
     r = plausibility(robot, result([2, -1], [1, 0.5], success=False))
     assert len(r) == 1 and "not a calibration" in r[0]
+    # a results file (what compensate and verify read) is checked the same way
+    from zerocal_sym.io.results import load_result
+
+    for offs, n_reasons in (([2, -1], 0), ([12, -1], 1)):
+        path = tmp_path / f"r{offs[0]}.json"
+        path.write_text(json.dumps(dict(result(offs, [1, 0.5]).to_dict(), mechanism=robot.mechanism_name)))
+        assert len(plausibility(robot, load_result(path, allow_failed=True, robot=robot))) == n_reasons
     # a rejected fit is not plausible; accepted despite misfit is
     th = kin.ik(robot, paper_poses(robot, 6))
     rd = VirtualPlant(robot, group_errors(1, "paper")).measure(th, SCALE, 1)

@@ -827,6 +827,11 @@ def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
                  max_maemm_mm: float = DEFAULT_MAX_MAEMM_MM) -> list:
     """Reasons not to use ``result`` as a calibration (empty list: plausible).
 
+    ``result``: an :class:`~zerocal_sym.identify.result.IdentificationResult`
+    or a results file read by :func:`zerocal_sym.io.results.load_result`
+    (``load_result(path, allow_failed=True, robot=robot)``, so that a failed
+    one is reported here rather than refused there).
+
     * not a calibration: ``success`` is False (not converged, not
       identifiable, the fit rejected) -- a result accepted despite misfit is
       one;
@@ -843,18 +848,19 @@ def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
     if not result.success:
         reasons.append(f"the identification is not a calibration: {result.status}")
     errors = robot.errors
-    off = result.zero_offsets_deg
+    off = np.asarray(result.zero_offsets_deg, float)
     for n, v in zip(errors.zero_offsets, off):
         if not np.isfinite(v):
             reasons.append(f"zero offset {n} is not a finite number")
         elif abs(v) > max_offset_deg:
             reasons.append(f"zero offset {n} = {v:+.4g} deg is beyond the plausible {max_offset_deg:g} deg "
                            "(a wrong joint zero, sign convention or robot file?)")
-    std = result.std_zero_offsets_deg
+    params = getattr(result, "params", None)  # None: a results file (io.results.ResultFile)
+    std = np.asarray(result.std_zero_offsets_deg, float)
     for n, s in zip(errors.zero_offsets, std):
-        if n in result.params and not np.isfinite(s):
+        if params is not None and n in params and not np.isfinite(s):
             reasons.append(f"the standard deviation of zero offset {n} is not finite (not identifiable)")
-    mm = result.maemm_mm
+    mm = np.asarray(result.maemm_mm, float)
     if mm.size and np.all(np.isfinite(mm)) and float(np.linalg.norm(mm)) > max_maemm_mm:
         reasons.append(f"MAEMM |rM| = {np.linalg.norm(mm):.4g} mm is beyond the plausible {max_maemm_mm:g} mm "
                        "(the measuring mechanism's c / d in the robot file?)")
