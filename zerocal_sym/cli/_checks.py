@@ -117,7 +117,22 @@ def _outputs(args, outputs, inputs) -> None:
 
 # --------------------------------------------------------------------------- per command
 
+def _trust(args) -> None:
+    """identify / verify: the fit check's and plausibility's options (issue 11)."""
+    if args.method == "tsvd":
+        bad = _given(args, "loss", "loss_scale")
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: for --method nlls only (the robust loss is an nlls fit)")
+    a = getattr(args, "fit_alpha", None)
+    if a is not None and not (math.isfinite(a) and 0 < a < 1):
+        raise ZerocalError(f"--fit-alpha must be a significance level in (0, 1), got {a:g}")
+    _positive(args, "loss_scale", " (standard deviations of a reading)")
+    _positive(args, "max_offset_deg", " of degrees")
+    _positive(args, "max_maemm_mm", " of mm")
+
+
 def _identify(args) -> None:
+    _trust(args)
     if args.method == "tsvd":
         bad = _given(args, "params", "prior_std", "bound", "max_iter")
         if bad:
@@ -155,6 +170,7 @@ def _compensate(args) -> None:
 
 
 def _verify(args) -> None:
+    _trust(args)
     _file_args(args, ("RESULT.json", args.result), ("DATA.csv", args.data))
     _outputs(args, [("--out", args.out), ("--plot", args.plot, VERIFY_PLOTS)],
              [("the results file", args.result), ("the measurement file", args.data)])

@@ -60,6 +60,58 @@ def add_arguments(p):
                    help="write residuals.png (measured minus predicted change per pose) into DIR and, for "
                         "simulated data (a '# true_errors:' line), boundary_errors.png (position error over the "
                         "workspace boundary before/after the compensation)")
+    add_trust_arguments(p)
+
+
+def add_trust_arguments(p, nlls_default=True):
+    """The fit-check and plausibility options (issue 11), shared by identify and verify."""
+    p.add_argument("--fit-alpha", type=float, default=0.001, metavar="ALPHA",
+                   help="significance level of the fit check: reject the fit when its chi2 p-value < ALPHA "
+                        "(default 0.001)")
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="keep a calibration the fit check rejects (recorded in the result as accept_misfit)")
+    p.add_argument("--loss", choices=["l2", "huber", "soft_l1"], default=None,
+                   help="nlls: robust loss (default l2); outlying readings are named and left out")
+    p.add_argument("--loss-scale", type=float, default=None, metavar="S",
+                   help="nlls: scale of the robust loss, in standard deviations of a reading")
+    p.add_argument("--max-offset-deg", type=float, default=10.0, metavar="DEG",
+                   help="refuse a result with a zero offset beyond this (default 10 deg)")
+    p.add_argument("--max-maemm-mm", type=float, default=50.0, metavar="MM",
+                   help="refuse a result with a MAEMM norm beyond this (default 50 mm)")
+
+
+def trust_kwargs(args, method):
+    """Keyword arguments of identify_nlls / identify_tsvd from the trust options."""
+    kw = {"fit_alpha": args.fit_alpha, "accept_misfit": bool(args.accept_misfit)}
+    if method == "nlls":
+        if args.loss is not None:
+            kw["loss"] = args.loss
+        if args.loss_scale is not None:
+            kw["loss_scale"] = args.loss_scale
+    return kw
+
+
+def diagnosis(res) -> str:
+    """The fit check's paragraph of a result ('' when there is none)."""
+    fit = res.info.get("fit") if isinstance(res.info, dict) else None
+    return (fit or {}).get("diagnosis") or ""
+
+
+def offsets_sigma_text(res) -> str:
+    """The offsets' 1 sigma and whether it is small against the offsets."""
+    import numpy as np
+
+    off = np.abs(np.asarray(res.zero_offsets_deg, float))
+    std = np.asarray(res.std_zero_offsets_deg, float)
+    if not np.all(np.isfinite(std)):
+        return "offsets' 1 sigma not available"
+    s = ", ".join(f"{x:.3g}" for x in std)
+    big = float(np.max(off)) if off.size else 0.0
+    small = bool(np.all(std <= 0.1 * np.maximum(off, 1e-12))) or float(np.max(std)) < 0.01
+    kind = f" ({res.std_kind})" if getattr(res, "std_kind", None) else ""
+    return (f"offsets' 1 sigma {s} deg{kind}: "
+            + ("small against the offsets" if small else
+               f"NOT small against the offsets (largest |offset| {big:.3g} deg); measure more poses"))
 
 
 def _parse_named(items, robot, names, what, parse):
@@ -109,7 +161,7 @@ def compensation_block(robot, res) -> dict:
     }
 
 
-def result_json(robot, meas, res, report, source) -> dict:
+def result_json(robot, meas, res, report, source, accept_misfit=False) -> dict:
     """The results JSON: IdentificationResult.to_dict plus robot, data, compensation, identifiability."""
     from zerocal_sym.io.files import json_safe
 
@@ -126,6 +178,7 @@ def result_json(robot, meas, res, report, source) -> dict:
     d["data"] = {"file": str(source), "K": int(meas.K), "data_robot_sha256": meas.meta.get("robot_sha256")}
     d["compensation"] = compensation_block(robot, res)
     d["identifiability"] = report
+    d["accept_misfit"] = bool(accept_misfit)
     return json_safe(d)
 
 
@@ -175,7 +228,7 @@ def run(args):
         if args.rule is not None:
             kw["rule"] = args.rule
         res = identify_tsvd(robot, meas, prior=prior, t=args.truncation, noise=None if noise.is_zero else noise,
-                            **kw)
+                            **kw, **trust_kwargs(args, "tsvd"))
     else:
         if args.truncation is not None or args.rule is not None:
             raise ZerocalError("--truncation and --rule are for --method tsvd")
@@ -199,16 +252,34 @@ def run(args):
         if args.max_iter is not None and args.max_iter < 1:
             raise ZerocalError("--max-iter must be >= 1")
         res = identify_nlls(robot, meas, names, noise=noise, prior=prior, bounds=bounds or None,
-                            prior_std=pstd or None, max_iter=args.max_iter)
+                            prior_std=pstd or None, max_iter=args.max_iter, **trust_kwargs(args, "nlls"))
     report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=res.full_vector())
-    out = result_json(robot, meas, res, report, args.data)
+    out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
     if not res.success:
         if args.json:
             print(to_json(out))
         elif args.report:
             print(format_report(report))
-        print(f"zerocal identify: identification failed ({res.method}): {res.status}; no calibration written",
-              file=sys.stderr)
+        why = "rejected" if res.status.startswith("rejected") else "identification failed"
+        print(f"zerocal identify: {why} ({res.method}): {res.status}; no calibration written", file=sys.stderr)
+        if diagnosis(res):
+            print(diagnosis(res), file=sys.stderr)
+        if not args.json:
+            print(f"verdict: rejected: {res.status}; next: see the diagnosis above, fix the data or the robot file "
+                  "and identify again")
+        return 1
+    from zerocal_sym.identify.fitcheck import plausibility
+
+    reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    if reasons:
+        out["plausibility"] = reasons
+        if args.json:
+            print(to_json(out))
+        print("zerocal identify: rejected: implausible result; no calibration written", file=sys.stderr)
+        for r in reasons:
+            print(f"  {r}", file=sys.stderr)
+        if not args.json:
+            print(f"verdict: rejected: {reasons[0]}; next: check the robot file, joint zeros and sign convention")
         return 1
     with staged_directory(args.plot) if args.plot else contextlib.nullcontext() as plot_dir:
         if args.plot:  # into a temporary directory, moved into place once everything is written
@@ -232,4 +303,20 @@ def run(args):
         print(format_report(report))
     if args.out:
         print(f"wrote {args.out}")
+    print(verdict_line(res, args))
     return 0
+
+
+def verdict_line(res, args) -> str:
+    """The one line a person acts on: accepted / why, the offsets' 1 sigma, the next command."""
+    fit = res.info.get("fit") or {}
+    p = fit.get("p_value")
+    if fit.get("accepted_despite_misfit"):
+        why = f"accepted despite misfit (--accept-misfit; fit p-value {p:.3g} < {fit.get('alpha', args.fit_alpha):g})"
+    elif fit.get("checked") and p is not None:
+        why = f"accepted: fit p-value {p:.3g} >= {fit.get('alpha', args.fit_alpha):g}"
+    else:
+        why = f"accepted: fit not checked ({fit.get('reason') or 'no spare degree of freedom'})"
+    nxt = (f"zerocal compensate {args.out} --out table.csv" if args.out else
+           f"zerocal identify {args.data} --out RESULT.json, then zerocal compensate RESULT.json --out table.csv")
+    return f"verdict: {why}; {offsets_sigma_text(res)}; next: {nxt}"
