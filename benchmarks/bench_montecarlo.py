@@ -82,7 +82,7 @@ TRUTHS = {"paper": "theta1 = 2\ntheta2 = -1\nrMx = 1\nrMy = 0.5",
 
 def study(label, robot, trials, chunk, workers, tmp):
     """The study runner in this process (run_study), one cell."""
-    from zerocal_sym.identify import study as st
+    from zerocal_sym.cli import study as st
 
     spec = Path(tmp) / f"{label}.toml"
     spec.write_text(SPEC.format(label=label, trials=trials, chunk=chunk, robot=robot, truth=TRUTHS[label]))

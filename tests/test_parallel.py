@@ -11,7 +11,8 @@ import pytest
 from zerocal_sym.cli import main
 from zerocal_sym.design import verify_design
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.identify import parallel, study
+from zerocal_sym.cli import study
+from zerocal_sym.identify import parallel
 from zerocal_sym.identify.montecarlo import compare as mc_compare
 from zerocal_sym.identify.parallel import Progress, Stats
 from zerocal_sym.paper.compare import compare
@@ -249,6 +250,8 @@ def test_study_cli_runs_and_summarises(tmp_path, capsys):
     d = json.loads(capsys.readouterr().out)
     assert [c["trials_done"] for c in d["cells"]] == [10, 10] and "run" not in d
     assert main(["study", str(spec), "--summary", str(tmp_path / "nothing")]) == 2
+    assert main(["study", str(spec), "--out", str(tmp_path / "p"), "--robot", "examples/delta.toml"]) == 2
+    assert "robots = [...]" in capsys.readouterr().err and not (tmp_path / "p").exists()
 
 
 @pytest.mark.parametrize("body, line, match", [
