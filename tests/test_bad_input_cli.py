@@ -201,14 +201,25 @@ def _result(tmp_path, **over):
 @pytest.mark.parametrize("over,pattern,line", [
     ({"zero_offsets_deg": [1.0]}, r"key 'zero_offsets_deg' must be a list of 2 numbers", 5),
     ({"zero_offsets_deg": [1.0, "x"]}, r"must be a list of 2 finite numbers", 5),
-    ({"success": False, "status": "Ipopt: Infeasible_Problem_Detected"}, r"the identification failed", 4),
-    ({"zero_offsets_deg": [45.0, 1.0]}, r"theta1 = 45 deg exceeds --max-offset-deg 10", None),
     ({"robot_sha256": "0" * 64}, r"identified on another robot", None),
 ])
 def test_bad_result_file(capsys, tmp_path, over, pattern, line):
     p = _result(tmp_path, **over)
     where = f"{p}:{line}" if line else str(p)
     check_error(capsys, tmp_path, ["compensate", str(p)], pattern, where=where, command="compensate")
+
+
+@pytest.mark.parametrize("over,pattern", [
+    ({"success": False, "status": "Ipopt: Infeasible_Problem_Detected"}, "not a calibration: Ipopt: Infeasible"),
+    ({"zero_offsets_deg": [45.0, 1.0]}, "theta1 = +45 deg is beyond the plausible 10 deg"),
+])
+def test_implausible_result_refused(capsys, tmp_path, over, pattern):
+    """A failed or implausible result: compensate refuses it (exit 1, one line with the reasons), writes nothing."""
+    p = _result(tmp_path, **over)
+    out = tmp_path / "table.csv"
+    rc = main(["compensate", str(p), "--out", str(out)])
+    o, err = capsys.readouterr()
+    assert rc == 1 and not out.exists() and len(err.strip().splitlines()) == 1 and pattern in err, err
 
 
 def test_result_not_json(capsys, tmp_path):

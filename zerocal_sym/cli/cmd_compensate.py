@@ -57,6 +57,8 @@ def check_result_robot(res, robot, where):
 
 
 def run(args):
+    import sys
+
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
@@ -81,14 +83,14 @@ def run(args):
     if args.n is not None and args.scheme is None:
         raise ZerocalError("--n is the number of poses per boundary of --scheme")
     if args.result is not None:
-        res = load_result(args.result, robot=robot)
+        from zerocal_sym.identify.fitcheck import plausibility
+
+        res = load_result(args.result, allow_failed=True, robot=robot)
         check_result_robot(res, robot, args.result)
-        big = np.abs(res.zero_offsets_deg) > args.max_offset_deg
-        if np.any(big):
-            j = int(np.flatnonzero(big)[0])
-            raise DataFileError(f"zero offset {joints[j]} = {res.zero_offsets_deg[j]:g} deg exceeds "
-                                f"--max-offset-deg {args.max_offset_deg:g}: not a zero offset (check the result)",
-                                where=args.result)
+        reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg)
+        if reasons:  # not a calibration: refused (exit 1), nothing written
+            print(f"zerocal compensate: refused {args.result}: {'; '.join(reasons)}", file=sys.stderr)
+            return 1
         offsets = res.zero_offsets_deg
     else:
         res, offsets = None, np.zeros(robot.m)
