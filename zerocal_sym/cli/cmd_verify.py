@@ -35,6 +35,40 @@ def add_arguments(p):
                    help="write the new result (readable by compensate and verify), atomically")
     p.add_argument("--plot", metavar="DIR", default=None,
                    help="write residuals.png (residuals per pose of the re-identification) into DIR")
+    from zerocal_sym.cli.cmd_identify import add_trust_arguments
+
+    add_trust_arguments(p)
+
+
+#: commanded angles within this of IK(target) - the result's offsets (deg) are "compensated with that result"
+COMMAND_TOL_DEG = 1e-3
+
+
+def check_compensated(robot, meas, offsets_deg, data) -> None:
+    """Refuse a round whose commands are not IK(target) - offsets (it was not compensated with that result)."""
+    import numpy as np
+
+    from zerocal_sym.errors import DataFileError
+    from zerocal_sym.io.compensation import compensated_commands
+
+    if meas.target is None:
+        return
+    try:
+        _, cmd = compensated_commands(robot, meas.target, offsets_deg)
+    except (ValueError, Exception) as exc:  # noqa: BLE001 - an unreachable target: the commands cannot match
+        raise DataFileError(f"the targets cannot be compensated with the result's offsets: {exc}",
+                            where=data) from None
+    diff = np.degrees(np.abs(np.asarray(meas.theta_cmd, float) - cmd))
+    bad = np.flatnonzero(np.max(diff, axis=1) > COMMAND_TOL_DEG)
+    if bad.size:
+        k = int(bad[0])
+        j = int(np.argmax(diff[k]))
+        joints = robot.mechanism.joint_names
+        line = meas.lines[k] if len(meas.lines) > k else None
+        raise DataFileError(
+            f"pose {k}: commanded {joints[j]} differs from IK(target) - the result's offset by {diff[k, j]:.4g} deg "
+            f"(> {COMMAND_TOL_DEG:g}): this round was not compensated with this result (zerocal compensate RESULT.json "
+            f"--template gives the compensated commands)", where=f"{data}:{line}" if line else data)
 
 
 def run(args):
@@ -44,7 +78,7 @@ def run(args):
 
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.cli.cmd_compensate import check_result_robot
-    from zerocal_sym.cli.cmd_identify import compensation_block
+    from zerocal_sym.cli.cmd_identify import compensation_block, trust_kwargs
     from zerocal_sym.errors import DataFileError, ZerocalError
     from zerocal_sym.io.compensation import parse_offsets
     from zerocal_sym.io.files import json_safe, staged_directory, to_json, write_json
@@ -74,6 +108,7 @@ def run(args):
             f"the data were measured with compensation {fmt(declared)} deg, not with the "
             f"result's offsets {fmt(applied.zero_offsets_deg)} deg",
             where=f"{args.data}:{line}" if line else args.data)
+    check_compensated(robot, meas, applied.zero_offsets_deg, args.data)
     noise = NoiseModel.named(args.noise)
     prior = errors.put(errors.zeros(), errors.zero_offsets, np.radians(applied.zero_offsets_deg))
     if np.all(np.isfinite(applied.maemm_mm)):
@@ -81,13 +116,30 @@ def run(args):
     if args.method == "tsvd":
         from zerocal_sym.identify.tsvd import identify_tsvd
 
-        res = identify_tsvd(robot, meas, prior=prior, noise=None if noise.is_zero else noise)
+        res = identify_tsvd(robot, meas, prior=prior, noise=None if noise.is_zero else noise,
+                            **trust_kwargs(args, "tsvd"))
     else:
         from zerocal_sym.identify.nlls import identify_nlls
 
-        res = identify_nlls(robot, meas, "paper", noise=noise, prior=prior)
+        res = identify_nlls(robot, meas, "paper", noise=noise, prior=prior, **trust_kwargs(args, "nlls"))
     if not res.success:
-        raise ZerocalError(f"re-identification failed ({res.method}): {res.status}", where=args.data)
+        import sys
+
+        from zerocal_sym.cli.cmd_identify import diagnosis
+
+        print(f"zerocal verify: re-identification {'rejected' if res.status.startswith('rejected') else 'failed'} "
+              f"({res.method}): {res.status}; no result written", file=sys.stderr)
+        if diagnosis(res):
+            print(diagnosis(res), file=sys.stderr)
+        return 1
+    from zerocal_sym.identify.fitcheck import plausibility
+
+    reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    if reasons:
+        import sys
+
+        print(f"zerocal verify: re-identification rejected: {'; '.join(reasons)}; no result written", file=sys.stderr)
+        return 1
     new = res.zero_offsets_deg
     remaining = new - applied.zero_offsets_deg
     mu = float(np.sqrt(np.mean(remaining**2)))
@@ -108,6 +160,7 @@ def run(args):
     }
     out = res.to_dict()
     out.update(mechanism=robot.mechanism_name, robot_sha256=robot.sha256, verification=report,
+               accept_misfit=bool(args.accept_misfit),
                compensation=compensation_block(robot, res))
     target = args.plot
     try:
