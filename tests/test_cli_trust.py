@@ -1,0 +1,116 @@
+"""Calibrations a user can trust (issue 11), through the CLI as the user meets it."""
+import json
+from pathlib import Path
+
+from zerocal_sym.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def zc(capsys, *argv):
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def simulate(capsys, path, *extra):
+    rc, out, err = zc(capsys, "simulate", "--group", 1, "--n", 6, *extra, "--out", path)
+    assert rc == 0, err
+    return path
+
+
+def drop_sha(path):
+    lines = [ln for ln in path.read_text().splitlines(keepends=True) if not ln.startswith("# robot_sha256:")]
+    path.write_text("".join(lines))
+
+
+def edit_reading(path, pose, delta):
+    lines = path.read_text().splitlines(keepends=True)
+    header = next(i for i, ln in enumerate(lines) if ln.startswith("pose,"))
+    cols = lines[header].strip().split(",")
+    r = cols.index("reading_mm")
+    row = lines[header + 1 + pose].rstrip("\n").split(",")
+    assert row[0] == str(pose)
+    row[r] = repr(float(row[r]) + delta)
+    lines[header + 1 + pose] = ",".join(row) + "\n"
+    path.write_text("".join(lines))
+
+
+def test_wrong_robot_file_rejected(capsys, tmp_path):
+    data = simulate(capsys, tmp_path / "d.csv")
+    drop_sha(data)
+    robot = tmp_path / "wrong.toml"
+    robot.write_text((ROOT / "examples" / "paper_robot.toml").read_text().replace("L = 375", "L = 380"))
+    out = tmp_path / "r.json"
+    rc, o, err = zc(capsys, "identify", data, "--robot", robot, "--out", out)
+    assert rc == 1 and not out.exists(), (o, err)
+    # the paragraph of the fit check (at K = 12 a robot-file error that shows mostly in one change looks like a
+    # bad reading: the diagnosis says so)
+    assert "rejected" in err and "The noise model rejects this fit" in err and "check the robot file" in err, err
+
+
+def test_bad_reading_named(capsys, tmp_path):
+    data = simulate(capsys, tmp_path / "d.csv", "--noise", "scale-only")
+    edit_reading(data, 5, 0.9)
+    out = tmp_path / "r.json"
+    rc, o, err = zc(capsys, "identify", data, "--noise", "scale-only", "--out", out)
+    assert rc == 1 and not out.exists(), (o, err)
+    assert "rejected" in err and "pose 5" in err, err
+    assert "verdict: rejected" in o
+    # --accept-misfit alone: the 0.9 mm reading drags the least-squares offsets to ~ -30 deg, which plausibility
+    # refuses (exit 1, no file)
+    rc, o, err = zc(capsys, "identify", data, "--noise", "scale-only", "--accept-misfit", "--out", out)
+    assert rc == 1 and not out.exists() and "beyond the plausible 10 deg" in err, err
+    # the user overrides the fit check and the plausibility limits: a calibration, and the result says so
+    rc, o, err = zc(capsys, "identify", data, "--noise", "scale-only", "--accept-misfit", "--max-offset-deg", 45,
+                    "--max-maemm-mm", 200, "--json", "--out", out)
+    assert rc == 0, err
+    d = json.loads(o)
+    assert d["accept_misfit"] is True and d["fit"]["accepted_despite_misfit"] is True
+    assert d["status"].startswith("accepted despite misfit") and json.loads(out.read_text()) == d
+
+
+def test_loss_with_tsvd_refused(capsys, tmp_path):
+    data = simulate(capsys, tmp_path / "d.csv")
+    rc, o, err = zc(capsys, "identify", data, "--method", "tsvd", "--loss", "huber")
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and "--loss" in err, err
+
+
+def test_verify_uncompensated_round_refused(capsys, tmp_path):
+    data = simulate(capsys, tmp_path / "d.csv")
+    res = tmp_path / "r.json"
+    rc, o, err = zc(capsys, "identify", data, "--out", res)
+    assert rc == 0, err
+    round2 = simulate(capsys, tmp_path / "round2.csv", "--seed", 1)  # measured without the compensation
+    rc, o, err = zc(capsys, "verify", res, round2)  # the file's '# compensation_deg: 0 0' line says so
+    assert rc == 2 and "measured with compensation (0, 0) deg" in err, err
+    round2.write_text("".join(ln for ln in round2.read_text().splitlines(keepends=True)
+                              if not ln.startswith("# compensation_deg:")))  # the commands themselves say so
+    rc, o, err = zc(capsys, "verify", res, round2)
+    assert rc == 2 and len(err.strip().splitlines()) == 1, err
+    assert "pose 0" in err and "not compensated with this result" in err, err
+
+
+def test_compensate_refuses_implausible_offset(capsys, tmp_path):
+    data = simulate(capsys, tmp_path / "d.csv")
+    res = tmp_path / "r.json"
+    assert zc(capsys, "identify", data, "--out", res)[0] == 0
+    d = json.loads(res.read_text())
+    d["zero_offsets_deg"][0] = 20.0
+    res.write_text(json.dumps(d))
+    table = tmp_path / "table.csv"
+    rc, o, err = zc(capsys, "compensate", res, "--out", table)
+    assert rc == 1 and not table.exists() and len(err.strip().splitlines()) == 1, err
+    assert "beyond the plausible 10 deg" in err
+
+
+def test_verdict_line(capsys, tmp_path):
+    data = simulate(capsys, tmp_path / "d.csv")
+    res = tmp_path / "r.json"
+    rc, o, err = zc(capsys, "identify", data, "--out", res)
+    assert rc == 0, err
+    last = o.strip().splitlines()[-1]
+    verdicts = [ln for ln in o.splitlines() if ln.startswith("verdict:")]
+    assert verdicts == [last]
+    assert last.startswith("verdict: accepted: fit p-value") and "1 sigma" in last
+    assert f"next: zerocal compensate {res} --out table.csv" in last
