@@ -114,3 +114,17 @@ def test_verdict_line(capsys, tmp_path):
     assert verdicts == [last]
     assert last.startswith("verdict: accepted: fit p-value") and "1 sigma" in last
     assert f"next: zerocal compensate {res} --out table.csv" in last
+
+
+def test_identify_reports_the_bias_from_the_omitted_errors(capsys, tmp_path):
+    """issue 13: identify states the bias its estimate may carry from the errors left out, within their tolerances."""
+    data = simulate(capsys, tmp_path / "d.csv", "--noise", "scale-only")
+    rc, out, err = zc(capsys, "identify", data, "--json", "--accept-misfit")
+    assert rc == 0, err
+    b = json.loads(out)["bias"]["zero_offsets"]
+    assert b["names"] == ["theta1", "theta2"] and all(w > r > 0 for w, r in zip(b["worst_case_deg"], b["rms_deg"]))
+    rc, out, err = zc(capsys, "identify", data, "--json", "--accept-misfit", "--tolerance-scale", "10")
+    b10 = json.loads(out)["bias"]["zero_offsets"]
+    assert b10["worst_case_deg"][0] == __import__("pytest").approx(10 * b["worst_case_deg"][0], rel=1e-6)
+    rc, out, err = zc(capsys, "identify", data, "--tolerance", "nope=1")
+    assert rc == 2 and "nope" in err and len(err.strip().splitlines()) == 1

@@ -54,6 +54,11 @@ def add_arguments(p):
     p.add_argument("--rule", choices=["threshold", "gcv", "discrepancy"], default=None,
                    help="tsvd truncation rule (default: tsvd's default)")
     p.add_argument("--report", action="store_true", help="also print the identifiability report (text output)")
+    p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
+                   help="tolerance of a source error left out of the identification (mm; deg for angles), for the "
+                        "bias the estimate may carry (default: the mechanism's, docs/design.md); repeatable")
+    p.add_argument("--tolerance-file", default=None, metavar="FILE", help="tolerances by name (TOML or JSON)")
+    p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S", help="every tolerance times S")
     p.add_argument("--json", action="store_true", help="print the results JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, help="write the results JSON here")
     p.add_argument("--plot", metavar="DIR", default=None,
@@ -215,6 +220,14 @@ def run(args):
     prior = maemm_prior_vector(robot, args.maemm_prior)
     meas = load_measurements(args.data, robot)  # refuses data of another mechanism or robot (robot_sha256)
     noise = NoiseModel.named(args.noise)
+    from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
+
+    try:  # the tolerances of the errors left out, checked before any work
+        tol_params = errors.resolve("offsets+measuring" if args.method == "tsvd" else args.params)
+    except ValueError:
+        tol_params = None  # a bad --params is reported below, with its own message
+    tol = (make_tolerances(robot, args.tolerance, args.tolerance_file, args.tolerance_scale, params=tol_params)
+           if tol_params is not None else None)
     if args.method == "tsvd":
         if args.params != "paper" or args.prior_std or args.bound or args.max_iter is not None:
             raise ZerocalError("--params, --prior-std, --bound and --max-iter are for --method nlls "
@@ -255,6 +268,8 @@ def run(args):
                             prior_std=pstd or None, max_iter=args.max_iter, **trust_kwargs(args, "nlls"))
     report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=res.full_vector())
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
+    bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=res.full_vector())
+    out["bias"] = bias
     if not res.success:
         if args.json:
             print(to_json(out))
@@ -295,6 +310,10 @@ def run(args):
     print(f"{args.data}: K = {meas.K} poses, robot {robot.name} ({robot.mechanism_name}), method {res.method}: "
           f"{res.status}")
     print_estimate(robot, res)
+    zo = bias["zero_offsets"]
+    print("bias the offsets may carry from the errors left out (first order, their tolerances): worst case "
+          + ", ".join(f"{v:.4g}" for v in zo["worst_case_deg"]) + " deg, RMS "
+          + ", ".join(f"{v:.4g}" for v in zo["rms_deg"]) + " deg (--tolerance NAME=VALUE to change)")
     info = res.info
     if res.method == "nlls":
         print(f"Ipopt: {info['solver_status']}, {info['iterations']} iterations, cost {info['cost']:.6g}, "
