@@ -334,6 +334,7 @@ def test_identify_options(capsys, tmp_path, files, tail, pattern):
     (["compare", "--methods", "nlls,tsvd", "--mu0", "0.2", "--trials", "2"], "--mu0: for the loop methods"),
     (["compare", "--methods", "scipy", "--max-iter", "5", "--trials", "2"], "--max-iter: for the loop methods"),
     (["compare", "--methods", ",", "--trials", "2"], "--methods: no method given"),
+    (["compare", "--methods", "tsvd,tsvd-loop", "--params", "all", "--trials", "2"], "--params: for the Ipopt"),
     (["compare", "--n", "99999999999999999999", "--trials", "2"], "--n 99999999999999999999: at most"),
     (["simulate", "--group", "1", "--n", "99999999999999999999", "--out", "OUT"], "at most 50000 poses"),
     (["design", "--n", "99999999999999999999"], "at most 50000 poses"),

@@ -87,9 +87,12 @@ def main(argv=None) -> int:
     try:
         from zerocal_sym.cli._checks import check_args
 
+        from zerocal_sym.cli._interrupt import installed
+
         args._given = _given_options(argv)
         check_args(args)  # options of the mode, numbers, outputs vs inputs: before any work
-        status = int(args._run(args) or 0)
+        with installed():  # Ctrl-C that a solver swallows is raised again (cli/_interrupt.py)
+            status = int(args._run(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at exit
         return status
     except ZerocalError as exc:
@@ -120,14 +123,10 @@ def _interrupted(args) -> int:
 
 
 def _from_interrupt(exc) -> bool:
-    """Whether ``exc`` was caused by Ctrl-C (a KeyboardInterrupt in its cause/context chain)."""
-    seen = set()
-    while exc is not None and id(exc) not in seen:
-        if isinstance(exc, KeyboardInterrupt):
-            return True
-        seen.add(id(exc))
-        exc = exc.__cause__ or exc.__context__
-    return False
+    """Whether ``exc`` was caused by Ctrl-C (:func:`zerocal_sym.cli._interrupt.is_interrupt`)."""
+    from zerocal_sym.cli._interrupt import is_interrupt
+
+    return is_interrupt(exc)
 
 
 def _stdout_closed() -> int:

@@ -51,6 +51,8 @@ DESIGN_TARGET_NOT = ("K", "criterion", "seed", "verify", "plot", "starts", "work
 DESIGN_SCHEME_ONLY = ("n", "eps0", "maemm_prior")
 
 LOOP_METHODS = ("tsvd-loop", "nlls-loop", "nlls-seq")
+#: compare methods that take --params (the TSVD ones identify the paper's set)
+PARAM_METHODS = ("nlls", "nlls-loop", "nlls-seq", "scipy")
 
 
 def _opt(dest: str) -> str:
@@ -195,6 +197,9 @@ def _compare(args) -> None:
     if bad and not loop:
         raise ZerocalError(f"{_opts(bad)}: for the loop methods ({', '.join(LOOP_METHODS)}) only; --methods "
                            f"{','.join(methods)} has none")
+    if _given(args, "params") and not [m for m in methods if m in PARAM_METHODS]:
+        raise ZerocalError(f"--params: for the Ipopt/scipy methods ({', '.join(PARAM_METHODS)}) only; the TSVD "
+                           f"methods identify the zero offsets and the MAEMM (--methods {','.join(methods)})")
     if args.max_iter is not None and args.max_iter < 1:
         raise ZerocalError(f"--max-iter must be >= 1 (identifications per loop), got {args.max_iter}")
     _positive(args, "mu0", " of degrees")
