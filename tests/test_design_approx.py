@@ -12,7 +12,7 @@ import pytest
 
 from zerocal_sym import design
 from zerocal_sym.cli import main
-from zerocal_sym.design import DesignError, approx, criteria
+from zerocal_sym.design import DesignError, approx, criteria, fewest, measure, posemodel, rounding
 from zerocal_sym.design import nlp as design_nlp
 from zerocal_sym.identify import bias, fisher
 from zerocal_sym.model import kinematics as kin
@@ -46,7 +46,7 @@ def reach450(robot):
 
 
 def _model(robot, criterion, X):
-    return approx.PoseModel(robot, X, NOISE, criterion)
+    return posemodel.PoseModel(robot, X, NOISE, criterion)
 
 
 # ----------------------------------------------------------------- the pose model and its derivatives
@@ -57,13 +57,13 @@ def test_fgh_matches_finite_differences(criterion):
     W = np.diag([1.0, 2.0, 0.0, 0.0])
     w = rng.uniform(size=9)
     w /= w.sum()
-    f, g, H = approx._fgh(criterion, R, W, 8, w, 1.0)
+    f, g, H = measure._fgh(criterion, R, W, 8, w, 1.0)
     e = 1e-6
     E = np.eye(9)
-    gn = np.array([(approx._fgh(criterion, R, W, 8, w + e * E[i], 1.0)[0]
-                    - approx._fgh(criterion, R, W, 8, w - e * E[i], 1.0)[0]) / (2 * e) for i in range(9)])
-    Hn = np.array([(approx._fgh(criterion, R, W, 8, w + e * E[i], 1.0)[1]
-                    - approx._fgh(criterion, R, W, 8, w - e * E[i], 1.0)[1]) / (2 * e) for i in range(9)])
+    gn = np.array([(measure._fgh(criterion, R, W, 8, w + e * E[i], 1.0)[0]
+                    - measure._fgh(criterion, R, W, 8, w - e * E[i], 1.0)[0]) / (2 * e) for i in range(9)])
+    Hn = np.array([(measure._fgh(criterion, R, W, 8, w + e * E[i], 1.0)[1]
+                    - measure._fgh(criterion, R, W, 8, w - e * E[i], 1.0)[1]) / (2 * e) for i in range(9)])
     np.testing.assert_allclose(g, gn, rtol=1e-6, atol=1e-8 * np.abs(g).max())
     np.testing.assert_allclose(H, Hn, rtol=1e-5, atol=1e-7 * np.abs(H).max())
 
@@ -80,7 +80,7 @@ def test_pose_model_bounds_every_order(robot):
             aq, v = criteria._terms_batch(robot, Q, NOISE)
             F = criteria._fisher_batch(aq, v, sm2)[0]
             m = _model(robot, "D", Q)
-            M, _ = approx._schur(*approx._stats(np.full(K, 1.0) / m.vt, m.aq))
+            M, _ = posemodel._schur(*posemodel._stats(np.full(K, 1.0) / m.vt, m.aq))
             assert np.linalg.eigvalsh(M - F).min() >= -1e-9 * np.linalg.eigvalsh(M).max()
 
 
@@ -95,7 +95,7 @@ def test_no_candidate_improves_the_optimal_measure(robot, ws_cons, criterion):
     X, _ = approx.candidate_poses(robot, ws_cons, 600)
     m = _model(robot, criterion, X)
     tol = 1e-5
-    sol = approx.solve_measure(m, criterion, tol=tol)
+    sol = measure.solve_measure(m, criterion, tol=tol)
     if criterion == "E":
         assert sol["eff_lb"] >= 0.99
         return
@@ -107,8 +107,8 @@ def test_no_candidate_improves_the_optimal_measure(robot, ws_cons, criterion):
     for a in (1e-3, 1e-2):
         w = (1 - a) * sol["w"]
         w[k] += a
-        M, c = approx._schur(*approx._stats(w / m.vt, m.aq))
-        loss = approx._crit(criterion, M, m.W)[0]
+        M, c = posemodel._schur(*posemodel._stats(w / m.vt, m.aq))
+        loss = posemodel._crit(criterion, M, m.W)[0]
         assert loss >= sol["loss"] - a * tol * (p := M.shape[0]) - 1e-12
 
 
@@ -119,8 +119,8 @@ def _exact_optimum(criterion, m):
     N = len(m.vt)
 
     def loss(w):
-        M, _ = approx._schur(*approx._stats(np.maximum(w, 0) / m.vt, m.aq))
-        val = approx._crit(criterion, M, m.W)[0]
+        M, _ = posemodel._schur(*posemodel._stats(np.maximum(w, 0) / m.vt, m.aq))
+        val = posemodel._crit(criterion, M, m.W)[0]
         return val if math.isfinite(val) else 1e6
 
     best = None
@@ -145,9 +145,9 @@ def test_certificate_bounds_the_true_gap_small_case(robot, criterion):
     rng = np.random.default_rng(3)
     for trial in range(8):
         w = rng.dirichlet(np.ones(len(X)) * (0.5 if trial % 2 else 3.0))
-        M, c = approx._schur(*approx._stats(w / m.vt, m.aq))
-        loss, G, s = approx._crit(criterion, M, m.W)
-        d = approx._sens(G, m.aq, c, m.vt)
+        M, c = posemodel._schur(*posemodel._stats(w / m.vt, m.aq))
+        loss, G, s = posemodel._crit(criterion, M, m.W)
+        d = posemodel._sens(G, m.aq, c, m.vt)
         if criterion == "D":
             true_eff = math.exp((best - loss) / p)  # (det M / det M*)^(1/p)
         else:
@@ -156,7 +156,7 @@ def test_certificate_bounds_the_true_gap_small_case(robot, criterion):
         assert true_eff >= bound * (1 - 1e-9), (trial, true_eff, bound)
         assert true_eff <= 1 + 1e-7
     # and our solver reaches the brute-force optimum
-    sol = approx.solve_measure(m, criterion, tol=1e-9)
+    sol = measure.solve_measure(m, criterion, tol=1e-9)
     assert sol["loss"] == pytest.approx(best, abs=1e-7)
 
 
@@ -165,7 +165,7 @@ def test_relaxation_bounds_every_ordered_design_brute_force(robot):
     X = np.array([[-240, 632], [240, 632], [-240, 782], [240, 782.0], [0, 632]])
     cons = design.make_constraints(robot)
     m = _model(robot, "crlb", X)
-    sol = approx.solve_measure(m, "crlb", tol=1e-9)
+    sol = measure.solve_measure(m, "crlb", tol=1e-9)
     bound_loss = approx._loss_bound("crlb", sol)
     K = 6
     bound_deg = approx._mass_value("crlb", bound_loss, K, 4)
@@ -186,15 +186,15 @@ def test_relaxation_bounds_every_ordered_design_brute_force(robot):
 def test_efficient_rounding():
     w = np.array([0.2937, 0.2937, 0.2049, 0.2049, 0.0014, 0.0014])
     for K in (6, 7, 20, 100, 701):
-        n = approx.efficient_rounding(w, K)
+        n = rounding.efficient_rounding(w, K)
         assert n.sum() == K and np.all(n >= 0)
         assert np.all(np.abs(n - K * w) <= len(w))
-    np.testing.assert_array_equal(approx.efficient_rounding(np.array([0.5, 0.5]), 4), [2, 2])
+    np.testing.assert_array_equal(rounding.efficient_rounding(np.array([0.5, 0.5]), 4), [2, 2])
 
 
 def test_realized_design_is_feasible_and_certified(robot, ws_cons, crlb_measure):
     K = 60
-    P, info = approx.realize(robot, crlb_measure, K, ws_cons, NOISE)
+    P, info = rounding.realize(robot, crlb_measure, K, ws_cons, NOISE)
     assert P.shape == (K, 2) and sum(info["counts"]) == K
     assert design.check_design(robot, P, ws_cons) == []
     v = design.criterion_values(robot, P, NOISE)["crlb"]
@@ -226,7 +226,7 @@ def test_exact_path_reports_certificate(robot, ws_cons):
 
 # ----------------------------------------------------------------- fewest poses for a target CRLB
 def test_fewest_poses_for_target(robot, ws_cons, crlb_measure):
-    out = approx.fewest_poses(robot, 0.2, ws_cons, NOISE, ad=crlb_measure)
+    out = fewest.fewest_poses(robot, 0.2, ws_cons, NOISE, ad=crlb_measure)
     K, lb = out["K"], out["K_lower_bound"]
     assert lb <= K and out["crlb_rms_deg"] <= 0.2
     # certified: the bound at K_lb - 1 poses is above the target
@@ -235,7 +235,7 @@ def test_fewest_poses_for_target(robot, ws_cons, crlb_measure):
     assert all(v > 0.2 for k, v in ev.items() if k < K)
     assert design.check_design(robot, out["poses"], ws_cons) == []
     with pytest.raises(DesignError, match="positive"):
-        approx.fewest_poses(robot, -1, ws_cons, NOISE, ad=crlb_measure)
+        fewest.fewest_poses(robot, -1, ws_cons, NOISE, ad=crlb_measure)
 
 
 def test_cli_target_crlb_json(capsys):

@@ -305,7 +305,7 @@ def _run_target(args, robot):
 
     from zerocal_sym import design
     from zerocal_sym.cli._common import write_out
-    from zerocal_sym.design import approx
+    from zerocal_sym.design.fewest import fewest_poses
     from zerocal_sym.io.files import json_safe, to_json
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.noise import NoiseModel
@@ -314,7 +314,7 @@ def _run_target(args, robot):
         raise design.DesignError("--plot is for --optimize (a --target-crlb design has K in the hundreds)")
     cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"))
-    res = approx.fewest_poses(robot, args.target_crlb, cons, noise)
+    res = fewest_poses(robot, args.target_crlb, cons, noise)
     P = np.asarray(res["poses"])
     out = {"robot": robot.name, "mechanism": robot.mechanism_name, "target_crlb_deg": res["target_crlb_deg"],
            "K": res["K"], "K_lower_bound": res["K_lower_bound"], "crlb_rms_deg": res["crlb_rms_deg"],

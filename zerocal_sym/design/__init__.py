@@ -9,8 +9,12 @@ Modules, each importing only from those before it: ``terms`` (per-pose terms
 of the design model), ``regions`` (the reachable set, clipped: issue 13;
 imported lazily by ``constraints``), ``constraints``, ``criteria``, ``order``
 (visiting order), ``exchange`` (discrete exchange), ``nlp`` (continuous
-design, Ipopt), ``approx`` (approximate designs with certificates, rounding,
-fewest poses for a target CRLB: issue 13), ``optimize`` (driver,
+design, Ipopt), the approximate designs of issue 13 -- ``posemodel`` (the
+order-free pose model, criteria), ``measure`` (the optimal measure and its
+certificate), ``rounding`` (K poses from a measure), ``fewest`` (fewest
+poses for a target CRLB; imports ``approx`` lazily), ``approx`` (the
+approximate design: candidates, travel windows, refinement, the bound),
+``mse`` (the bias-aware measure) --, ``optimize`` (driver,
 :func:`optimize_design`), ``verify`` (Monte Carlo) and ``plot``.  The public
 API is re-exported here.
 """
@@ -23,8 +27,9 @@ from zerocal_sym.design.order import best_order
 from zerocal_sym.design.exchange import candidate_grid, exchange_design
 from zerocal_sym.design.nlp import PSD_FORM, continuous_design
 from zerocal_sym.design.regions import Box, Polygon, ReachableRegion, make_reachable
-from zerocal_sym.design.approx import (APPROX_CRITERIA, ApproxDesign, approximate_design, efficient_rounding,
-                                       fewest_poses, realize)
+from zerocal_sym.design.approx import APPROX_CRITERIA, ApproxDesign, approximate_design
+from zerocal_sym.design.rounding import efficient_rounding, realize
+from zerocal_sym.design.fewest import fewest_poses
 from zerocal_sym.design.optimize import (EXACT_MAX_K, DesignResult, boundary_baseline, choose_baseline,
                                          optimize_design, paper_baseline)
 from zerocal_sym.design.verify import default_true_errors, verify_design

@@ -270,9 +270,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     * ``approx`` -- the optimal design measure over candidate poses
       (:func:`zerocal_sym.design.approx.approximate_design`), rounded to K
       poses with replicates around its support and a visiting order
-      (:func:`zerocal_sym.design.approx.realize`); seconds for K in the
+      (:func:`zerocal_sym.design.rounding.realize`); seconds for K in the
       hundreds.  ``mse``: the measure is improved locally for the bias
-      (:func:`zerocal_sym.design.approx.mse_measure`); ``cond``: exact only.
+      (:func:`zerocal_sym.design.mse.mse_measure`); ``cond``: exact only.
     * ``auto`` (default) -- ``exact`` for K <= :data:`EXACT_MAX_K` (and for
       ``cond``), ``approx`` beyond.
 
@@ -306,7 +306,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     -------
     DesignResult
     """
-    from zerocal_sym.design import approx as apx
+    from zerocal_sym.design.approx import approximate_design
+    from zerocal_sym.design.mse import mse_measure
+    from zerocal_sym.design.rounding import realize
 
     _check_k(K, robot)
     _check_criterion(criterion)
@@ -328,7 +330,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     ad = None
     mcrit = "crlb" if criterion == "mse" else criterion
     if method == "approx" or (certificate and criterion != "cond"):
-        ad = apx.approximate_design(robot, mcrit, cons, noise, tolerances=tolerances)
+        ad = approximate_design(robot, mcrit, cons, noise, tolerances=tolerances)
         timing["approximate"] = time.perf_counter() - t0
     base, base_label, base_note, rejected = choose_baseline(robot, K, cons)
     scheme = robot.workspace.scheme_name
@@ -337,8 +339,8 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         t1 = time.perf_counter()
         mad = ad
         if criterion == "mse":
-            mad = apx.mse_measure(robot, ad, K, cons, noise, tolerances)
-        P, info = apx.realize(robot, mad, K, cons, noise, tolerances, criterion)
+            mad = mse_measure(robot, ad, K, cons, noise, tolerances)
+        P, info = realize(robot, mad, K, cons, noise, tolerances, criterion)
         timing["round_order"] = time.perf_counter() - t1
         label = "approximate +round +order"
         approx_info = mad.to_dict(K)

@@ -1,0 +1,250 @@
+"""The optimal design measure on a set of candidate poses, and its certificate (issue 13).
+
+The criteria, their directional derivatives ``d(x)`` and the efficiency
+bounds are those of the order-free pose model
+(:mod:`zerocal_sym.design.posemodel`).
+
+Algorithm (:func:`solve_measure`): multiplicative updates
+``w_x <- w_x (d(x) / sum w d)^lambda`` (``lambda`` = 1 for D, 1/2 for the
+linear criteria, 1/(q+1) for E) find the rough support; then an active-set
+loop optimises the measure restricted to the support and the worst
+violators of the equivalence theorem (projected Newton on the simplex,
+:func:`_restricted`, on the criterion's convex form :func:`_fgh`) until the
+efficiency bound is within ``tol`` of 1 over all candidates.  E is reached
+by continuation in q up to :data:`~zerocal_sym.design.posemodel.E_Q`, and its
+certificate is :func:`e_certificate`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from zerocal_sym.design.constraints import DesignError
+from zerocal_sym.design.posemodel import E_Q, PoseModel, _evaluate, _exponent, _sens
+
+#: default target efficiency gap of the measure (efficiency lower bound >= 1 - TOL)
+TOL = 1e-4
+#: active-set sizes of :func:`solve_measure`: support points kept, violators added per round
+MAX_ACTIVE, MAX_ADD = 60, 20
+
+
+def _regressors(aq, vt):
+    """``g_x = (1, aq_x) / sqrt(vt_x)``, shape (N, p + 1): the pose model with its free constant."""
+    return np.column_stack([np.ones(len(vt)), aq]) / np.sqrt(vt)[:, None]
+
+
+def _fgh(criterion, R, W, q, w, escale=None):
+    """Convex form of the criterion on regressors ``R`` (S, p + 1): value, gradient and Hessian in ``w``.
+
+    In terms of ``N = sum_x w_x g_x g_x^T`` (the pose model with its free
+    constant; ``M^-1 = (N^-1)_pp``): D ``-log det N + log N_00``, linear
+    ``tr(W~ N^-1)`` (``W~`` = ``W`` padded), E ``tr(P^q)`` with
+    ``P = (N^-1)_pp / escale``.  Hessians: ``A o A - g0^2 g0^2T / N_00^2``,
+    ``2 A o B`` and, for E, ``q (2 A o (U P^(q-1) U^T) + Z diag(Gamma) Z^T)``
+    (``A = R N^-1 R^T``, ``B = R N^-1 W~ N^-1 R^T``, ``U`` the rows
+    ``(N^-1 g_x)_p``, ``Gamma`` the divided differences of ``pi^(q-1)``).
+    """
+    N = (R.T * w) @ R
+    try:
+        L = np.linalg.cholesky(N)
+    except np.linalg.LinAlgError:
+        return math.inf, None, None
+    Li = np.linalg.inv(L)
+    Ninv = Li.T @ Li
+    Y = R @ Ninv
+    A = Y @ R.T
+    if criterion == "D":
+        g0 = R[:, 0] ** 2
+        N00 = N[0, 0]
+        f = -2 * float(np.sum(np.log(np.diag(L)))) + math.log(N00)
+        return f, -np.diag(A) + g0 / N00, A * A - np.outer(g0, g0) / N00 ** 2
+    if criterion != "E":
+        Yp = Y[:, 1:]
+        Bm = Yp @ W @ Yp.T
+        return float(np.sum(W * Ninv[1:, 1:])), -np.diag(Bm), 2 * A * Bm
+    P = Ninv[1:, 1:] / escale
+    pi, V = np.linalg.eigh(P)
+    pi = np.maximum(pi, 0)
+    Ua = (Y[:, 1:] / math.sqrt(escale)) @ V  # rows a_x = V^T u_x
+    Pq1 = (Ua * pi ** (q - 1)) @ Ua.T
+    f = float(np.sum(pi ** q))
+    ks = np.arange(q - 1)
+    Gam = np.einsum("ki,kj->ij", pi[None, :] ** ks[:, None], pi[None, :] ** (q - 2 - ks)[:, None])
+    Z = np.einsum("xi,xj->xij", Ua, Ua).reshape(len(w), -1)
+    H = q * (2 * A * Pq1 + (Z * Gam.ravel()) @ Z.T)
+    return f, -q * np.diag(Pq1), H
+
+
+def _restricted(criterion, W, q, R, w0, tol=1e-13, max_iter=200):
+    """The optimal measure on a few regressors (projected Newton on the simplex) from ``w0``.
+
+    Active-set Newton: on the free weights the KKT system of the Newton step
+    with ``sum(dw) = 0``; a step that would make a weight negative stops at
+    zero and frees it; a zero weight whose gradient is below the multiplier
+    is freed again.  Returns the weights, shape (S,).
+    """
+    S = len(w0)
+    w = np.maximum(np.asarray(w0, float), 0)
+    w /= w.sum()
+    escale = None
+    if criterion == "E":
+        N = (R.T * w) @ R
+        escale = float(np.linalg.eigvalsh(np.linalg.inv(N)[1:, 1:])[-1])
+    free = w > 0
+    f, g, H = _fgh(criterion, R, W, q, w, escale)
+    if g is None:
+        return w
+    for _ in range(max_iter):
+        F = np.flatnonzero(free)
+        n = len(F)
+        Hf = H[np.ix_(F, F)]
+        reg = 1e-12 * max(float(np.trace(Hf)) / n, 1e-300)
+        KKT = np.zeros((n + 1, n + 1))
+        KKT[:n, :n] = Hf + reg * np.eye(n)
+        KKT[:n, n] = KKT[n, :n] = 1.0
+        sol = np.linalg.lstsq(KKT, np.concatenate([-g[F], [0.0]]), rcond=None)[0]
+        dw, nu = sol[:n], sol[n]
+        lam = -nu  # multiplier: g_i = lam on the support at the optimum
+        # free a zero weight that wants to grow
+        zero = np.flatnonzero(~free)
+        if len(zero):
+            viol = zero[g[zero] < lam - 1e-10 * abs(lam)]
+            if len(viol) and np.max(np.abs(dw)) < 1e-9:
+                free[viol[np.argmin(g[viol])]] = True
+                continue
+        slope = float(g[F] @ dw)
+        if not slope < -tol * max(abs(f), 1e-300):
+            if len(zero) and np.any(g[zero] < lam - 1e-10 * abs(lam)):
+                free[zero[np.argmin(g[zero])]] = True
+                continue
+            break
+        neg = dw < 0
+        tmax = float(np.min(-w[F][neg] / dw[neg])) if np.any(neg) else math.inf
+        t = min(1.0, tmax)
+        while True:
+            wn = w.copy()
+            wn[F] = np.maximum(w[F] + t * dw, 0)
+            if t == tmax:
+                wn[F[neg][np.argmin(-w[F][neg] / dw[neg])]] = 0.0
+            wn /= wn.sum()
+            fn, gn, Hn = _fgh(criterion, R, W, q, wn, escale)
+            if gn is not None and fn <= f + 1e-4 * t * slope:
+                break
+            t *= 0.5
+            if t < 1e-14:
+                return w
+        w, f, g, H = wn, fn, gn, Hn
+        free = w > 0
+    return w
+
+
+def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, q=E_Q, certify=True):
+    """Optimal measure on the candidates of ``model`` for a concave criterion.
+
+    A few multiplicative steps from ``w0`` find the rough support; then an
+    active-set loop: the measure restricted to the support and the candidates
+    with the largest ``d(x)`` is optimised (projected Newton on the simplex,
+    :func:`_restricted`), and the
+    worst violators of the equivalence theorem are added, until the
+    efficiency bound is within ``tol`` of 1 over *all* candidates.
+
+    Parameters
+    ----------
+    w0 : ndarray, shape (N,), optional
+        Start (default uniform).
+    tol : float
+        Stop when the efficiency lower bound is at least ``1 - tol``.
+
+    Returns
+    -------
+    dict
+        ``w`` (N,), ``M`` (p, p), ``c`` (p,), ``d`` (N,), ``loss``,
+        ``s`` (``sum w d``), ``eff_lb`` (lower bound on the efficiency:
+        D ``p / max d``, linear criteria ``L / max d``, E from
+        :func:`e_certificate`), ``iterations`` (restricted solves), ``q`` (E only).
+    """
+    N = len(model.vt)
+    if N == 0:
+        raise DesignError("no candidate poses")
+    aq, vt, W = model.aq, model.vt, model.W
+    w = np.full(N, 1.0 / N) if w0 is None else np.maximum(np.asarray(w0, float), 0)
+    w = w / w.sum()
+    qs = [q] if criterion != "E" else [qq for qq in (4, 16, 64) if qq < q] + [q]
+    rounds = 0
+    for qq in qs:
+        lam = _exponent(criterion, qq)
+        for _ in range(30):  # multiplicative steps: the rough support
+            loss, grad, d, s, M, c = _evaluate(criterion, W, qq, w, aq, vt)
+            if grad is None:
+                raise DesignError("the candidate poses cannot identify the parameters (singular information)")
+            w = w * np.maximum(d / s, 0) ** lam
+            w /= w.sum()
+        for _ in range(max_rounds):
+            loss, grad, d, s, M, c = _evaluate(criterion, W, qq, w, aq, vt)
+            eff = s / d.max()
+            if eff >= 1 - tol:
+                break
+            rounds += 1
+            sup = np.argsort(-w)[:MAX_ACTIVE]
+            sup = sup[w[sup] > 1e-6 * w[sup[0]]]
+            top = np.argsort(-d)[:MAX_ADD]
+            act = np.union1d(sup, top[d[top] > s])
+            wa = w[act] + 1e-3 / len(act)
+            w = np.zeros(N)
+            w[act] = _restricted(criterion, W, qq, _regressors(aq[act], vt[act]), wa / wa.sum())
+    loss, grad, d, s, M, c = _evaluate(criterion, W, qs[-1], w, aq, vt)
+    out = {"w": w, "M": M, "c": c, "d": d, "loss": loss, "s": s, "iterations": rounds, "q": qs[-1]}
+    if criterion == "E":  # the E-certificate (a small optimisation) only when asked; else the smooth one's
+        out["eff_lb"], out["E_bound"] = e_certificate(model, M, c) if certify else (float(s / d.max()), None)
+    else:
+        out["eff_lb"] = float(s / d.max())
+    return out
+
+
+def e_certificate(model: PoseModel, M, c):
+    """Lower bound on the E-efficiency: ``lambda_min(M) / min_E max_x h_x^T E h_x`` over a few trace-one ``E``.
+
+    Returns
+    -------
+    eff_lb : float
+    bound : float
+        Upper bound on ``lambda_min`` of any measure on the candidates.
+    """
+    ev, U = np.linalg.eigh(M)
+    best = math.inf
+    trials = [np.outer(U[:, 0], U[:, 0])]
+    for s in (1, 2, 4, 8, 16, 33, 65, 129, 257):
+        e = (ev / ev[0]) ** (-float(s))
+        trials.append((U * (e / e.sum())) @ U.T)
+    for E in trials:
+        best = min(best, float(_sens(E, model.aq, c, model.vt).max()))
+    # E = V Z V^T on the eigenvectors of the smallest eigenvalues, Z >= 0 with trace 1 chosen to
+    # minimise max_x h_x^T E h_x (a small convex problem; any such E gives a valid bound)
+    k = int(min(len(ev), max(2, np.sum(ev <= 1.5 * ev[0]))))
+    if k > 1:
+        from scipy.optimize import minimize
+
+        Hs = ((model.aq - c) / np.sqrt(model.vt)[:, None]) @ U[:, :k]  # (N, k)
+        top = np.argsort(-np.sum(Hs ** 2, axis=1))[:400]
+        Hs = Hs[top]
+        tri = np.tril_indices(k)
+
+        def zmat(x):
+            Lz = np.zeros((k, k))
+            Lz[tri] = x
+            Z = Lz @ Lz.T
+            return Z / np.trace(Z)
+
+        def fmax(x, beta):
+            vals = np.einsum("xi,ij,xj->x", Hs, zmat(x), Hs)
+            m = vals.max()
+            return m + np.log(np.sum(np.exp(beta * (vals - m) / m))) * m / beta
+
+        x = np.eye(k)[tri]
+        for beta in (20.0, 200.0, 2000.0):
+            x = minimize(fmax, x, args=(beta,), method="Nelder-Mead",
+                         options={"xatol": 1e-10, "fatol": 1e-14, "maxiter": 4000}).x
+        Ez = U[:, :k] @ zmat(x) @ U[:, :k].T
+        best = min(best, float(_sens(Ez, model.aq, c, model.vt).max()))
+    return float(ev[0] / best), best
