@@ -125,7 +125,7 @@ def run(args, robot):
     import numpy as np
 
     from zerocal_sym import design
-    from zerocal_sym.design import constraints, criteria, optimize
+    from zerocal_sym.design import criteria, limits, optimize
     from zerocal_sym.cli._common import check_scheme, default_n, write_out
     from zerocal_sym.io.files import to_json
     from zerocal_sym.model.noise import NoiseModel
@@ -134,7 +134,7 @@ def run(args, robot):
     if getattr(args, "target_crlb", None) is not None:
         return _run_target(args, robot)
     K = args.K if args.K is not None else 2 * default_n(robot)
-    constraints._check_k(K, robot)
+    limits._check_k(K, robot)
     criteria._check_criterion(args.criterion)
     verify = int(getattr(args, "verify", 0) or 0)
     if verify < 0:
@@ -148,8 +148,8 @@ def run(args, robot):
         raise design.DesignError(f"--starts needs at least 1, got {starts}")
     tol = tolerances_from_args(robot, args)
     method = getattr(args, "method", "auto")
-    if method == "exact" and K > constraints.MAX_K_EXACT:
-        raise design.DesignError(f"K = {K} is too large for --method exact (at most {constraints.MAX_K_EXACT}; "
+    if method == "exact" and K > limits.MAX_K_EXACT:
+        raise design.DesignError(f"K = {K} is too large for --method exact (at most {limits.MAX_K_EXACT}; "
                                  "--method approx takes any K)")
     cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"))

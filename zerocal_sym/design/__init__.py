@@ -6,8 +6,10 @@ Generic over the mechanism (issue 10): poses (K, n), joints (K, m), the p = m + 
 parameters of the paper's Eq. (28); the design region is the workspace's shape.
 
 Modules, each importing only from those before it: ``terms`` (per-pose terms
-of the design model), ``regions`` (the reachable set, clipped: issue 13;
-imported lazily by ``constraints``), ``constraints``, ``criteria``, ``order``
+of the design model), ``limits`` (bounds on K, defaults, :class:`DesignError`),
+``regions`` (the reachable set, clipped: issue 13; imported lazily by
+``shapes`` and ``constraints``), ``shapes`` (regions of the workspace's shape, any region
+validated), ``constraints`` (and the feasibility checks), ``criteria``, ``order``
 (visiting order), ``exchange`` (discrete exchange), ``nlp`` (continuous
 design, Ipopt), the approximate designs of issue 13 -- ``posemodel`` (the
 order-free pose model, criteria), ``measure`` (the optimal measure and its
@@ -19,9 +21,9 @@ approximate design: candidates, travel windows, refinement, the bound),
 API is re-exported here.
 """
 from zerocal_sym.design.terms import design_params, pose_terms
-from zerocal_sym.design.constraints import (MAX_K, MAX_K_EXACT, MIN_K, SCALE_RANGE_MM, TRAVEL_MODES, Constraints, CylinderRegion,
-                                            DesignError, Region, check_design, make_constraints, make_region, min_k,
-                                            workspace_region)
+from zerocal_sym.design.limits import MAX_K, MAX_K_EXACT, MIN_K, SCALE_RANGE_MM, TRAVEL_MODES, DesignError, min_k
+from zerocal_sym.design.shapes import CylinderRegion, Region, make_region, workspace_region
+from zerocal_sym.design.constraints import Constraints, check_design, make_constraints
 from zerocal_sym.design.criteria import CRITERIA, criteria_table, criterion_values, evaluate, position_report
 from zerocal_sym.design.order import best_order
 from zerocal_sym.design.exchange import candidate_grid, exchange_design

@@ -35,9 +35,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from zerocal_sym.design.constraints import Constraints, DesignError, _pointwise_ok, make_constraints
+from zerocal_sym.design.constraints import Constraints, _pointwise_ok, make_constraints
 from zerocal_sym.design.criteria import _check_criterion, _criterion_weights, _user_value
 from zerocal_sym.design.fewest import fewest_poses  # noqa: F401 - kept importable from here (benchmarks)
+from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.measure import TOL, e_certificate, solve_measure
 from zerocal_sym.design.posemodel import E_Q, PoseModel, _crit, _schur, _sens, _stats
 from zerocal_sym.design.terms import Weights

@@ -61,7 +61,8 @@ import numpy as np
 
 from zerocal_sym.errors import PoseError
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.design.constraints import Constraints, DesignError, check_design
+from zerocal_sym.design.limits import DesignError
+from zerocal_sym.design.constraints import Constraints, check_design
 from zerocal_sym.design.terms import Weights, _crlb_weights, _qscale, design_params, pose_terms
 
 #: criterion name -> (description, units, better: "min" | "max"); p = m + n parameters

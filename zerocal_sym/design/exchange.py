@@ -10,8 +10,8 @@ import time
 
 import numpy as np
 
-from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, _feasible_random_subset,
-                                            _pointwise_ok, make_constraints)
+from zerocal_sym.design.limits import DesignError, _check_k
+from zerocal_sym.design.constraints import Constraints, _feasible_random_subset, _pointwise_ok, make_constraints
 from zerocal_sym.design.criteria import (_check_criterion, _criterion_terms, _criterion_weights, _noise_terms,
                                          _objective_batch, _user_value)
 from zerocal_sym.design.terms import _qscale, pose_terms

@@ -11,7 +11,8 @@ import math
 import time
 from typing import TYPE_CHECKING
 
-from zerocal_sym.design.constraints import Constraints, DesignError, make_constraints
+from zerocal_sym.design.constraints import Constraints, make_constraints
+from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.rounding import realize
 
 if TYPE_CHECKING:
@@ -43,7 +44,7 @@ def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, nois
         A target that needs more than ``k_max`` poses.
     """
     from zerocal_sym.design.approx import approximate_design
-    from zerocal_sym.design.constraints import MAX_K, min_k
+    from zerocal_sym.design.limits import MAX_K, min_k
     from zerocal_sym.design.criteria import criterion_values
     from zerocal_sym.model.noise import NoiseModel
 

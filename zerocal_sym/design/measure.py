@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from zerocal_sym.design.constraints import DesignError
+from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.posemodel import E_Q, PoseModel, _evaluate, _exponent, _sens
 
 #: default target efficiency gap of the measure (efficiency lower bound >= 1 - TOL)

@@ -38,8 +38,9 @@ import time
 
 import numpy as np
 
-from zerocal_sym.design.constraints import (Constraints, DesignError, _check_k, _feasible_random_subset,
-                                            _pointwise_ok, check_design, make_constraints)
+from zerocal_sym.design.limits import DesignError, _check_k
+from zerocal_sym.design.constraints import (Constraints, _feasible_random_subset, _pointwise_ok, check_design,
+                                            make_constraints)
 from zerocal_sym.design.criteria import (EXTENDED, _check_criterion, _criterion_weights, _fisher_batch,
                                          _noise_terms, _objective, _objective_batch, _terms_batch, _user_value)
 from zerocal_sym.design.terms import Weights, _crlb_weights, _pose_terms_fn, _qscale, pose_terms

@@ -39,8 +39,9 @@ import numpy as np
 
 from zerocal_sym.io.files import json_safe
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.design.constraints import (MAX_K_EXACT, Constraints, CylinderRegion, DesignError, Region, _check_k,
-                                            check_design, make_constraints, workspace_region)
+from zerocal_sym.design.limits import MAX_K_EXACT, DesignError, _check_k
+from zerocal_sym.design.shapes import CylinderRegion, Region, workspace_region
+from zerocal_sym.design.constraints import Constraints, check_design, make_constraints
 from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective, evaluate
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design

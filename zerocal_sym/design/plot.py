@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym.design.constraints import Region, workspace_region
+from zerocal_sym.design.shapes import Region, workspace_region
 from zerocal_sym.design.optimize import DesignResult
 from zerocal_sym.design.terms import _call_ik, pose_terms
 

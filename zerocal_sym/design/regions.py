@@ -9,7 +9,7 @@ pose (the assembly mode the model uses), clipped by optional bounds:
 
 * :class:`Box` -- ``lo <= P <= hi`` per coordinate, open sides as ``-inf`` /
   ``inf`` (planar ``XMIN XMAX YMIN YMAX``; 3-D ``XMIN XMAX YMIN YMAX ZMIN ZMAX``);
-* :class:`~zerocal_sym.design.constraints.CylinderRegion` -- ``RW ZMIN ZMAX``
+* :class:`~zerocal_sym.design.shapes.CylinderRegion` -- ``RW ZMIN ZMAX``
   on the z axis (3-D);
 * :class:`Polygon` -- a simple polygon ``(x1, y1), (x2, y2), ...`` (planar;
   convex or not).
@@ -360,7 +360,7 @@ def make_reachable(robot, clip=None, margin=0.2, joint_limits_deg=None, grid_poi
     """
     from scipy import ndimage
 
-    from zerocal_sym.design.constraints import workspace_region
+    from zerocal_sym.design.shapes import workspace_region
 
     n = robot.n
     signs = mode_signs(robot)

@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from zerocal_sym.design.constraints import Constraints, DesignError, _pointwise_ok, make_constraints
+from zerocal_sym.design.constraints import Constraints, _pointwise_ok, make_constraints
 from zerocal_sym.design.criteria import _criterion_terms, _criterion_weights, _noise_terms, _objective_batch
+from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.terms import _qscale, pose_terms
 
 if TYPE_CHECKING:

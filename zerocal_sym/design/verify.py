@@ -8,7 +8,7 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.design.constraints import DesignError
+from zerocal_sym.design.limits import DesignError
 
 #: default true zero offsets (deg), the first m of them: joint 1, 2, 3 (planar: Table 2 group 1)
 DEFAULT_OFFSETS_DEG = (2.0, -1.0, 0.5)
