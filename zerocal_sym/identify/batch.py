@@ -20,10 +20,11 @@ import numpy as np
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.nlls import GN_STEP_TOL, identify_nlls, noise_terms
 from zerocal_sym.identify.nlls_problem import GN_BLOCKS, get_problem
-from zerocal_sym.model.fastcall import FastCall
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel
 
+#: a batch of at least this many data sets makes the problem hot (compiled, :mod:`zerocal_sym.model.compiled`)
+HOT_BATCH = 50
 #: data sets per mapped call (memory and the size of the mapped Function stay bounded)
 CHUNK = 1000
 
@@ -67,16 +68,6 @@ class BatchResult:
         return self.estimate[:, [self.params.index(n) for n in names]]
 
 
-_FAST: dict = {}
-
-
-def _mapped(prob, n):
-    key = (id(prob), n)
-    if key not in _FAST:
-        _FAST[key] = FastCall(prob.batch(n))
-    return _FAST[key]
-
-
 def _gauss_newton_blocks(prob, z, P):
     """Blocks of Gauss-Newton over the columns of (z, P), each data set until its last step is small.
 
@@ -89,7 +80,7 @@ def _gauss_newton_blocks(prob, z, P):
     J = np.full((n, K - 1, p), np.nan)
     todo = np.arange(n)
     for _ in range(GN_BLOCKS):  # only the data sets not yet converged go on
-        zk, sk, rk, _, Jk, *_ = _mapped(prob, todo.size)(z[:, todo], P[:, todo])
+        zk, sk, rk, _, Jk, *_ = prob.batch(todo.size)(z[:, todo], P[:, todo])
         z[:, todo] = zk.reshape(p, todo.size, order="F")
         step[todo] = np.ravel(sk)
         r[todo] = rk.reshape(K - 1, todo.size, order="F").T
@@ -128,6 +119,8 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
     p = len(names)
     scale = fisher.parameter_scale(robot, names)
     prob = get_problem(robot, K, names)
+    if N >= HOT_BATCH:
+        prob.hot()
     mu = errors.take(prior_q, names)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, np.zeros(K - 1), scale, mu, np.zeros((p, p)),
                     *noise_terms(noise))

@@ -159,8 +159,8 @@ def band_whitener(l, b) -> np.ndarray:
     n = l.size
     L = np.diag(l)
     if n > 1:
-        L[np.arange(1, n), np.arange(n - 1)] = np.ravel(b)[: n - 1]
-    return np.linalg.solve(L, np.eye(n))
+        L.ravel()[n::n + 1] = np.ravel(b)[: n - 1]   # the sub-diagonal
+    return np.linalg.inv(L)
 
 
 class _Linear:
@@ -173,7 +173,7 @@ class _Linear:
     the fitted coordinates to the scaled parameters ``z`` (``p = z / scale``).
     """
 
-    def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None):
+    def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None):
         self.r = np.asarray(r, float)
         self.J = np.atleast_2d(np.asarray(J, float))
         self.W = np.asarray(W, float)
@@ -186,12 +186,18 @@ class _Linear:
         self.n_prior_rows = int(n_prior_rows)
         self.point = point
         #: False when the exact model cannot be evaluated there (a pose is not an assembly with these errors)
-        self.valid = bool(np.all(np.isfinite(self.r)) and np.all(np.isfinite(self.J)) and np.all(np.isfinite(self.W)))
+        self.valid = bool(np.isfinite(self.r).all() and np.isfinite(self.J).all() and np.isfinite(self.W).all())
         if not self.valid:
             self.r = np.where(np.isfinite(self.r), self.r, 0.0)
             self.J = np.where(np.isfinite(self.J), self.J, 0.0)
             self.W = np.where(np.isfinite(self.W), self.W, 0.0)
-        U, s, Vt = np.linalg.svd(self.J, full_matrices=False)
+            svd = None
+        # ``svd``: the caller's thin SVD of this J (its U may carry extra zero rows below), or None
+        if svd is None:
+            U, s, Vt = np.linalg.svd(self.J, full_matrices=False)
+        else:
+            U, s, Vt = svd
+            U = U[: self.J.shape[0]]
         tol = RANK_RTOL * (s[0] if s.size else 0.0)
         self.rank = int(np.sum(s > tol)) if s.size else 0
         self.U, self.s, self.Vt = U[:, : self.rank], s[: self.rank], Vt[: self.rank]
@@ -267,23 +273,23 @@ def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
     elif dof <= 0:
         fit["reason"] = "the fit cannot be checked (no spare degrees of freedom)"
     else:
-        p = chi2_sf(chi2, dof)
-        pl = chi2_cdf(chi2, dof)
+        pl, p = _gamma_pq(0.5 * dof, 0.5 * chi2)   # lower and upper tails at once (chi2_cdf, chi2_sf)
         fit.update(checked=True, p_value=p, p_value_lower=pl, rejected=bool(p < alpha))
         if pl < alpha:
             fit["warnings"].append(
                 f"chi2 = {chi2:.4g} is far below its {dof} degrees of freedom (lower-tail p = {_fmt_p(pl)}): the "
                 "noise model overstates the noise, so the standard deviations are too large (conservative)")
-    rows = []
-    for j in range(lin.n):
-        rows.append({"pose": int(lin.poses[j]), "from_pose": int(lin.poses[j]) - 1,
-                     "residual_mm": float(lin.raw[j]), "whitened": float(lin.r[j]), "leverage": float(lev[j]),
-                     "standardised": None if not np.isfinite(t[j]) else float(t[j]),
-                     "estimated_error_mm": None if not np.isfinite(delta[j]) else float(delta[j])})
-    fit["readings"] = rows
+    n = lin.n
+    tt = np.where(np.isfinite(t), t, np.nan).tolist()
+    dd = np.where(np.isfinite(delta), delta, np.nan).tolist()
+    fit["readings"] = [{"pose": k, "from_pose": k - 1, "residual_mm": e, "whitened": w, "leverage": v,
+                        "standardised": None if ts != ts else ts, "estimated_error_mm": None if ds != ds else ds}
+                       for k, e, w, v, ts, ds in zip(lin.poses[:n].tolist(), lin.raw[:n].tolist(), lin.r[:n].tolist(),
+                                                     lev[:n].tolist(), tt, dd)]
     fit["worst"] = None
-    if np.any(np.isfinite(t)):
-        j = int(np.nanargmax(np.abs(t)))
+    at = np.where(np.isfinite(t), np.abs(t), -1.0)
+    if at.size and at.max() >= 0.0:
+        j = int(np.argmax(at))
         w = {"pose": int(lin.poses[j]), "from_pose": int(lin.poses[j]) - 1, "standardised": float(t[j]),
              "estimated_error_mm": float(delta[j]), "chi2_without": None, "p_value_without": None}
         if fit["checked"] and dof >= 2:

@@ -256,6 +256,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     z0 = np.clip(x0 * scale, lbx, ubx)
 
     prob = get_problem(robot, K, names)
+    prob.touch()
     solver = prob.solver_for(max_iter)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
     fast = prob.fast
@@ -311,7 +312,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         J = np.vstack([Jk, J[K - 1:]])
     Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
     # F = J^T J (data + prior information, scaled units) from one SVD of J: F = V diag(sJ^2) V^T
-    _, sJ, Vt = np.linalg.svd(J, full_matrices=False)
+    UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False)
     sF = sJ**2
     sv = (np.linalg.svd(Jd, compute_uv=False) if np.any(w) else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
     tol = RANK_RTOL * (sF[0] if sF.size else 0.0)
@@ -383,7 +384,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     if robust is None:
         lin = fitcheck._Linear(np.concatenate([r, rp[rows]]), np.vstack([Jd, J[K - 1:][rows]]),
                                fitcheck.band_whitener(l, b), np.arange(1, K), s - pred, np.eye(len(names)),
-                               scale, names, len(rows))
+                               scale, names, len(rows),
+                               svd=None if rows.size else (UJ, sJ, Vt))  # no prior rows: J's SVD is Jd's
         at = "estimate"
     else:
         lin = _robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
@@ -532,11 +534,12 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     prob = get_problem(robot, theta_cmd.shape[0], names)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], scale,
                     errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
-    l, b = (o.full().ravel() for o in prob.weights(errors.take(prior_q, names) * scale, par))
+    fs = prob.functions
+    l, b = (o.full().ravel() for o in fs["weights"](errors.take(prior_q, names) * scale, par))
     if callbacks == "fast":
-        rfun, jfun = FastCall(prob.rfun), FastCall(prob.jfun)
+        rfun, jfun = FastCall(fs["rfun"]), FastCall(fs["jfun"])
         return (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy()), scale
     if callbacks != "plain":
         raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
-    rfun, jfun = prob.rfun, prob.jfun
+    rfun, jfun = fs["rfun"], fs["jfun"]
     return (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full()), scale

@@ -91,6 +91,7 @@ class SourceErrors:
             if e.role not in ROLES:
                 raise ValueError(f"source error {e.name!r}: unknown role {e.role!r}")
         self.extra_sets = dict(extra_sets or {})
+        self._resolved = {}   # resolve(spec) by spec: the sets and names do not change after construction
 
     def __len__(self) -> int:
         return len(self.items)
@@ -148,6 +149,16 @@ class SourceErrors:
         ValueError
             An unknown name, or an empty set.
         """
+        spec = spec if isinstance(spec, str) else tuple(spec)
+        try:
+            hit = self._resolved.get(spec)
+        except TypeError:  # unhashable entries: _resolve says what is wrong
+            return self._resolve(spec)
+        if hit is None:
+            hit = self._resolved[spec] = self._resolve(spec)
+        return hit
+
+    def _resolve(self, spec) -> tuple:
         if isinstance(spec, str):
             spec = [p.strip() for p in spec.replace("+", ",").split(",") if p.strip()]
         chosen = set()
