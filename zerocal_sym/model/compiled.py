@@ -28,6 +28,7 @@ Functions with the same names, inputs and outputs:
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
@@ -131,6 +132,23 @@ def build(src: str, path: Path, cc: str) -> None:
         os.replace(out, path)
 
 
+@contextlib.contextmanager
+def _build_lock(path: Path):
+    """An exclusive advisory lock on ``path``'s lock file (no-op where ``fcntl`` is missing)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: concurrent builds are only wasteful (os.replace keeps them safe)
+        yield
+        return
+    with open(path.with_suffix(".lock"), "a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
 def load(functions: dict, path: Path) -> dict:
     """``external`` Functions of the same names from the library at ``path``."""
     import casadi as ca
@@ -157,9 +175,11 @@ def compile_functions(functions: dict, tag: str, cached_only: bool = False) -> d
             return None
         for attempt in (0, 1):
             if not path.exists():
-                t = time.perf_counter()
-                build(source(functions, "zc_" + path.stem.rsplit("-", 1)[-1]), path, cc)
-                _log(tag, f"compiled in {time.perf_counter() - t:.1f} s: {path}")
+                with _build_lock(path):  # another process building the same library: wait for it, then load
+                    if not path.exists():
+                        t = time.perf_counter()
+                        build(source(functions, "zc_" + path.stem.rsplit("-", 1)[-1]), path, cc)
+                        _log(tag, f"compiled in {time.perf_counter() - t:.1f} s: {path}")
             try:
                 out = _checked(functions, load(functions, path))
                 break
