@@ -176,3 +176,28 @@ def test_an_unknown_mode_is_a_user_error_naming_the_modes(monkeypatch, value):
     monkeypatch.setenv("ZEROCAL_COMPILE", value)
     with pytest.raises(ZerocalError, match="auto, always, never"):
         compiled.mode()
+
+
+def test_an_unfinished_background_build_does_not_outlive_the_process(tmp_path):
+    """A command that ends while the compiler runs stops it (no orphaned compiler, no library half-written)."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    cache = tmp_path / "cache"
+    code = ("from zerocal_sym.model.robot import paper_robot\n"
+            "from zerocal_sym.identify.nlls_problem import get_problem\n"
+            "import time\nfrom zerocal_sym.model import compiled\n"
+            "p = get_problem(paper_robot(), 42, 'paper')\n"
+            "p.hot()\nt0 = time.time()\n"
+            "while not compiled._RUNNING and time.time() - t0 < 60: time.sleep(0.05)\n"
+            "print('compiled' if p.compiled else 'interpreted')\n")
+    env = dict(os.environ, ZEROCAL_CACHE=str(cache), ZEROCAL_COMPILE="auto")
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "interpreted"  # a K = 42 build takes longer than a second
+    time.sleep(0.5)
+    ps = subprocess.run(["ps", "-eo", "args"], capture_output=True, text=True).stdout
+    assert str(cache) not in ps
+    assert not list(cache.glob("*.so"))

@@ -28,6 +28,7 @@ Functions with the same names, inputs and outputs:
 """
 from __future__ import annotations
 
+import atexit
 import contextlib
 import hashlib
 import os
@@ -126,10 +127,35 @@ def build(src: str, path: Path, cc: str) -> None:
         c = Path(tmp) / "src.c"
         c.write_text(src)
         out = Path(tmp) / path.name
-        proc = subprocess.run([cc, *CFLAGS, str(c), "-o", str(out), "-lm"], capture_output=True, text=True)
+        proc = subprocess.Popen([cc, *CFLAGS, str(c), "-o", str(out), "-lm"], stdout=subprocess.DEVNULL,
+                                stderr=subprocess.PIPE, text=True)
+        with _RUNNING_LOCK:
+            _RUNNING.add(proc)
+        try:
+            _, err = proc.communicate()
+        finally:
+            with _RUNNING_LOCK:
+                _RUNNING.discard(proc)
         if proc.returncode != 0:
-            raise RuntimeError(f"{cc} failed ({proc.returncode}): {proc.stderr.strip()[-400:]}")
+            raise RuntimeError(f"{cc} failed ({proc.returncode}): {err.strip()[-400:]}")
         os.replace(out, path)
+
+
+_RUNNING: set = set()     # compiler processes of background builds
+_RUNNING_LOCK = threading.Lock()
+
+
+@atexit.register
+def _stop_builds():
+    """At exit, stop the compilers of unfinished background builds (a later build removes their folders)."""
+    with _RUNNING_LOCK:
+        procs = list(_RUNNING)
+    for proc in procs:
+        try:
+            proc.kill()
+            proc.wait(timeout=5)
+        except Exception:  # noqa: BLE001 - exiting anyway
+            pass
 
 
 @contextlib.contextmanager
