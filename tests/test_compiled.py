@@ -62,6 +62,7 @@ def _inputs(f, rng):
             for i in range(f.n_in())]
 
 
+@pytest.mark.slow
 def test_compiled_functions_equal_the_interpreted_bit_for_bit(robot, built, data):
     """Every compiled twin returns the interpreted Function's numbers exactly, at the data and at random inputs."""
     prob = _fresh(robot)
@@ -129,6 +130,7 @@ def test_a_cached_library_is_loaded_not_rebuilt(robot, built):
     assert libs[0].stat().st_mtime_ns == stamp
 
 
+@pytest.mark.slow
 def test_a_damaged_cached_library_is_rebuilt(robot, cache):
     """Garbage where the library should be (never loaded in this process: a loaded one is never rewritten)."""
     prob = _fresh(robot)
@@ -178,6 +180,7 @@ def test_an_unknown_mode_is_a_user_error_naming_the_modes(monkeypatch, value):
         compiled.mode()
 
 
+@pytest.mark.slow
 def test_an_unfinished_background_build_does_not_outlive_the_process(tmp_path):
     """A command that ends while the compiler runs stops it (no orphaned compiler, no library half-written)."""
     import os
