@@ -12,9 +12,10 @@ from zerocal_sym.cli import main
 from zerocal_sym.design import verify_design
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.cli import study
-from zerocal_sym.identify import parallel
+from zerocal_sym.identify import parallel, stats
 from zerocal_sym.identify.montecarlo import compare as mc_compare
-from zerocal_sym.identify.parallel import Progress, Stats
+from zerocal_sym.identify.progress import Progress
+from zerocal_sym.identify.stats import Stats
 from zerocal_sym.paper.compare import compare
 from zerocal_sym.paper.scheme import paper_poses
 
@@ -49,7 +50,7 @@ def test_stats_merge_is_the_whole():
     np.testing.assert_allclose(parts.mean, X.mean(axis=0), rtol=1e-12)
     np.testing.assert_allclose(parts.rms, np.sqrt(np.mean(X**2, axis=0)), rtol=1e-12)
     np.testing.assert_allclose(parts.std, X.std(axis=0, ddof=1), rtol=1e-10)
-    for k, q in parallel.QUANTILES.items():
+    for k, q in stats.QUANTILES.items():
         np.testing.assert_array_equal(parts.quantiles()[k], np.quantile(X, q, axis=0))
         np.testing.assert_array_equal(whole.quantiles()[k], parts.quantiles()[k])
     assert Stats(2).mean is None and Stats(2).quantiles() is None

@@ -41,7 +41,7 @@ def run(args):
     from zerocal_sym.cli import _parallel
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.cli import study as st
-    from zerocal_sym.identify.parallel import Progress
+    from zerocal_sym.identify.progress import Progress
     from zerocal_sym.io.files import to_json
 
     if args.robot:

@@ -64,8 +64,9 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.identify.parallel import (OneShotTask, QUANTILES, Stats, chunk_ranges, describe_scheduler,
-                                          one_shot_chunk, run_chunks)
+from zerocal_sym.identify.one_shot import OneShotTask, one_shot_chunk
+from zerocal_sym.identify.parallel import chunk_ranges, describe_scheduler, run_chunks
+from zerocal_sym.identify.stats import QUANTILES, Stats
 
 SPEC_KEYS = ("name", "seed", "trials", "chunk", "params", "streams", "robots", "noise", "design", "truth")
 DESIGN_KEYS = ("scheme", "n", "poses", "robots", "label")

@@ -53,7 +53,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     (:class:`~zerocal_sym.model.noise.VirtualPlant`) with fresh noise and
     identifies the paper's p = m + n parameters (zero offsets and MAEMM) with
     :func:`zerocal_sym.identify.nlls.identify_nlls` (same noise model for
-    weighting), in batches (:func:`zerocal_sym.identify.parallel.one_shot_monte_carlo`:
+    weighting), in batches (:func:`zerocal_sym.identify.one_shot.one_shot_monte_carlo`:
     trial t draws from ``SeedSequence([seed, 0, t])``, so the result does not
     depend on ``workers`` or ``scheduler``).
 
@@ -87,7 +87,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         (Ipopt not converged, excluded), ``time_s``.
     """
     from zerocal_sym.identify import fisher
-    from zerocal_sym.identify.parallel import one_shot_monte_carlo
+    from zerocal_sym.identify.one_shot import one_shot_monte_carlo
 
     if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:
         raise DesignError(f"the number of Monte Carlo trials must be a positive integer, got {n_trials!r}")

@@ -24,14 +24,11 @@ Interruption
     (which ignore SIGINT) are terminated, a Dask client we opened is closed,
     and the exception propagates.  Nothing is merged or written after it.
 
-Statistics (:class:`Stats`)
-    Per quantity: count, sum, sum of squares and the samples themselves (for
-    quantiles); merging two is addition and concatenation.
-
-One-shot trials (:func:`one_shot_chunk`, :func:`one_shot_monte_carlo`)
-    Simulate a chunk's scale readings at fixed commanded joints and identify
-    them in one :func:`~zerocal_sym.identify.batch.identify_batch` call (the
-    design verification and the study runner).
+This module holds the chunks (:func:`chunk_ranges`, :func:`trial_rng`) and
+their execution.  The mergeable statistics of the results are in
+:mod:`zerocal_sym.identify.stats`, the progress display in
+:mod:`zerocal_sym.identify.progress`, the one-shot trials (the design
+verification and the study runner) in :mod:`zerocal_sym.identify.one_shot`.
 """
 from __future__ import annotations
 
@@ -39,18 +36,17 @@ import math
 import os
 import pickle
 import signal
-import sys
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
 from zerocal_sym.errors import ZerocalError
+# kept importable from here (zerocal_sym/identify/montecarlo.py imports them from this module)
+from zerocal_sym.identify.progress import Progress  # noqa: F401
+from zerocal_sym.identify.stats import Stats  # noqa: F401
 
 #: seconds to wait for a Dask scheduler (override: ZEROCAL_SCHEDULER_TIMEOUT)
 SCHEDULER_TIMEOUT_S = 10.0
-#: quantiles reported (5 %, median, 95 %)
-QUANTILES = {"q05": 0.05, "median": 0.5, "q95": 0.95}
 
 
 # --------------------------------------------------------------------------- options
@@ -88,149 +84,6 @@ def chunk_ranges(trials: int, chunk: int):
 def trial_rng(seed: int, stream: int, trial: int) -> np.random.Generator:
     """The random generator of one trial: ``SeedSequence([seed, stream, trial])``."""
     return np.random.default_rng(np.random.SeedSequence([int(seed), int(stream), int(trial)]))
-
-
-# --------------------------------------------------------------------------- statistics
-
-class Stats:
-    """Mergeable statistics of row vectors of width ``w``.
-
-    ``count``, ``sum`` (w,), ``sumsq`` (w,) and the samples (for quantiles);
-    :meth:`merge` adds and concatenates, so statistics of chunks combine into
-    those of the whole run.  Merged in the same order, the same chunks give
-    bit-identical results.
-    """
-
-    __slots__ = ("width", "count", "sum", "sumsq", "parts", "keep")
-
-    def __init__(self, width: int, keep: bool = True):
-        self.width = int(width)
-        self.count = 0
-        self.sum = np.zeros(self.width)
-        self.sumsq = np.zeros(self.width)
-        self.parts = []
-        self.keep = keep  # keep the samples (quantiles); False: moments only
-
-    @classmethod
-    def of(cls, rows, width: int | None = None, keep: bool = True) -> "Stats":
-        """Statistics of the rows of ``rows`` (shape (N, w); (N,) is one column)."""
-        a = np.asarray(rows, float)
-        if a.ndim == 1:
-            a = a.reshape(-1, 1) if width in (None, 1) else a.reshape(-1, width)
-        if a.size == 0:
-            a = a.reshape(0, a.shape[1] if a.ndim == 2 and a.shape[1] else (width or 1))
-        st = cls(a.shape[1], keep)
-        st.count = a.shape[0]
-        if st.count:
-            st.sum = np.sum(a, axis=0)
-            st.sumsq = np.sum(a * a, axis=0)
-            st.parts = [a] if keep else []
-        return st
-
-    def merge(self, other: "Stats") -> "Stats":
-        """Add ``other`` to this (in place); returns self."""
-        if other.count:
-            if self.count and other.width != self.width:
-                raise ValueError(f"cannot merge statistics of width {other.width} into width {self.width}")
-            if not self.count:
-                self.width = other.width
-                self.sum = np.zeros(self.width)
-                self.sumsq = np.zeros(self.width)
-            self.count += other.count
-            self.sum = self.sum + other.sum
-            self.sumsq = self.sumsq + other.sumsq
-            if self.keep:
-                self.parts.extend(other.parts)
-        return self
-
-    def __getstate__(self):
-        return {k: getattr(self, k) for k in self.__slots__}
-
-    def __setstate__(self, st):
-        for k, v in st.items():
-            setattr(self, k, v)
-
-    @property
-    def samples(self) -> np.ndarray:
-        """All rows, shape (count, w), in merge order."""
-        return np.concatenate(self.parts, axis=0) if self.parts else np.zeros((0, self.width))
-
-    @property
-    def mean(self):
-        """ndarray (w,), or None without samples."""
-        return self.sum / self.count if self.count else None
-
-    @property
-    def rms(self):
-        """Root mean square, ndarray (w,), or None."""
-        return np.sqrt(self.sumsq / self.count) if self.count else None
-
-    @property
-    def std(self):
-        """Sample standard deviation (ddof = 1), ndarray (w,), or None for fewer than 2 samples."""
-        if self.count < 2:
-            return None
-        var = (self.sumsq - self.sum**2 / self.count) / (self.count - 1)
-        return np.sqrt(np.maximum(var, 0.0))
-
-    def quantiles(self, qs=QUANTILES) -> dict | None:
-        """``{name: ndarray (w,)}`` of the quantiles ``qs`` (name -> fraction), or None."""
-        if not self.count or not self.keep:
-            return None
-        S = self.samples
-        return {k: np.quantile(S, q, axis=0) for k, q in qs.items()}
-
-    def max(self):
-        return np.max(self.samples, axis=0) if self.count and self.keep else None
-
-
-# --------------------------------------------------------------------------- progress
-
-class Progress:
-    """Progress on stderr: a tqdm bar on a terminal; otherwise a line every 10 %.
-
-    ``progress(done)`` with the number of trials done; ``enabled=False``
-    (``--quiet``) prints nothing.  :meth:`close` ends the bar.
-    """
-
-    def __init__(self, total: int, label: str = "compare", stream=None, enabled: bool = True):
-        self.total, self.label, self.enabled = max(1, int(total)), label, enabled
-        self.stream = sys.stderr if stream is None else stream
-        self.t0 = time.perf_counter()
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.next_pct = 10
-        self._bar = None
-        self._done = 0
-
-    def __call__(self, done: int) -> None:
-        if not self.enabled:
-            return
-        done = int(done)
-        if self.tty:
-            if self._bar is None:
-                from tqdm import tqdm
-
-                self._bar = tqdm(total=self.total, desc=self.label, file=self.stream, unit="trial",
-                                 mininterval=0.2, dynamic_ncols=True, leave=True)
-            self._bar.update(done - self._done)
-            self._done = done
-            if done >= self.total:
-                self.close()
-            return
-        frac = done / self.total
-        if 100 * frac >= self.next_pct or done == self.total:
-            while self.next_pct <= 100 * frac:
-                self.next_pct += 10
-            el = time.perf_counter() - self.t0
-            eta = el / frac - el if frac > 0 else float("nan")
-            bar = "#" * int(30 * frac) + "." * (30 - int(30 * frac))
-            self.stream.write(f"{self.label} [{bar}] {done}/{self.total}  {el:.1f} s, eta {eta:.0f} s\n")
-            self.stream.flush()
-
-    def close(self) -> None:
-        if self._bar is not None:
-            self._bar.close()
-            self._bar = None
 
 
 # --------------------------------------------------------------------------- execution
@@ -402,98 +255,3 @@ def _run_dask(fn, tasks, scheduler, finished):
     finally:
         if owned:
             client.close()
-
-
-# --------------------------------------------------------------------------- one-shot trials
-
-@dataclass
-class OneShotTask:
-    """A chunk of one-shot trials: simulate at ``theta`` with the truth ``err``, identify in one batch.
-
-    Attributes
-    ----------
-    robot : Robot
-    theta : ndarray, shape (K, m)
-        Commanded joints (rad).
-    err : ndarray, shape (q,)
-        True source errors (rad, mm).
-    noise : NoiseModel
-    params : tuple of str
-    seed, stream : int
-        Trial ``t`` draws from ``SeedSequence([seed, stream, t])``.
-    start, stop : int
-        Trials ``start .. stop-1``.
-    """
-
-    robot: object
-    theta: np.ndarray
-    err: np.ndarray
-    noise: object
-    params: tuple
-    seed: int
-    stream: int
-    start: int
-    stop: int
-
-
-def simulate_readings(robot, plant, theta, noise, seed, stream, start, stop) -> np.ndarray:
-    """Scale readings of trials ``start .. stop-1`` at the commanded joints, shape (stop - start, K)."""
-    return np.array([plant.measure(theta, noise, trial_rng(seed, stream, t)) for t in range(start, stop)]
-                    ).reshape(stop - start, np.shape(theta)[0])
-
-
-def one_shot_chunk(task: OneShotTask) -> dict:
-    """Simulate and identify one chunk (runs in a worker).
-
-    Returns
-    -------
-    dict
-        Columns: ``trial`` (n,) int64, ``estimate`` (n, p), ``std`` (n, p),
-        ``chi2`` (n,), ``success`` (n,) bool, ``confirmed`` (n,) bool; and
-        ``time_s`` (the identification).
-    """
-    from zerocal_sym.identify.batch import identify_batch
-    from zerocal_sym.model.noise import VirtualPlant
-
-    plant = VirtualPlant(task.robot, task.err)
-    R = simulate_readings(task.robot, plant, task.theta, task.noise, task.seed, task.stream, task.start, task.stop)
-    t = time.perf_counter()
-    b = identify_batch(task.robot, task.theta, R, task.params, noise=task.noise)
-    return {"trial": np.arange(task.start, task.stop, dtype=np.int64), "estimate": b.estimate, "std": b.std,
-            "chi2": b.chi2, "success": b.success, "confirmed": b.confirmed,
-            "time_s": time.perf_counter() - t}
-
-
-def concat_columns(parts) -> dict:
-    """The columns of several chunk results, concatenated in order (``time_s`` summed)."""
-    parts = [p for p in parts if p is not None]
-    if not parts:
-        return {}
-    out = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k != "time_s"}
-    out["time_s"] = float(sum(p.get("time_s", 0.0) for p in parts))
-    return out
-
-
-def one_shot_monte_carlo(robot, theta, err, trials: int, noise=None, params="paper", seed: int = 0,
-                         stream: int = 0, chunk: int | None = None, workers: int = 1, scheduler=None,
-                         progress=None) -> dict:
-    """``trials`` one-shot identifications at fixed commanded joints, chunked (see :func:`one_shot_chunk`).
-
-    Returns
-    -------
-    dict
-        The concatenated columns (trial order) and ``params``.
-    """
-    from zerocal_sym.model.noise import NoiseModel
-
-    noise = NoiseModel.paper() if noise is None else noise
-    names = robot.errors.resolve(params)
-    theta = np.atleast_2d(np.asarray(theta, float))
-    err = robot.errors.check_vector(np.asarray(err, float), "err_true")
-    chunk = default_chunk(trials, 1000) if chunk is None else int(chunk)
-    ranges = chunk_ranges(int(trials), chunk)
-    tasks = [OneShotTask(robot, theta, err, noise, names, int(seed), int(stream), a, b) for a, b in ranges]
-    res = run_chunks(one_shot_chunk, tasks, [b - a for a, b in ranges], workers, scheduler, progress)
-    out = concat_columns(res)
-    out["params"] = names
-    return out
