@@ -11,7 +11,7 @@ import pytest
 from zerocal_sym.cli import main
 from zerocal_sym.design import verify_design
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.cli import study
+from zerocal_sym.cli import study, study_chunks, study_spec
 from zerocal_sym.identify import parallel, stats
 from zerocal_sym.identify.montecarlo import compare as mc_compare
 from zerocal_sym.identify.progress import Progress
@@ -113,12 +113,12 @@ def test_local_cluster_equals_local_run(robot, tmp_path):
     kw = dict(trials=3, seed=5, methods=("tsvd", "nlls"))
     local = compare(robot, **kw)
     spec = _spec(tmp_path, trials=12, chunk=5)
-    s_local = study.run_study(study.load_spec(spec), tmp_path / "local")
+    s_local = study.run_study(study_spec.load_spec(spec), tmp_path / "local")
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         remote = compare(robot, scheduler=client, **kw)
         by_address = compare(robot, scheduler=cluster.scheduler_address, **kw)
-        s_remote = study.run_study(study.load_spec(spec), tmp_path / "remote", scheduler=client)
+        s_remote = study.run_study(study_spec.load_spec(spec), tmp_path / "remote", scheduler=client)
     assert _numbers(local) == _numbers(remote) == _numbers(by_address)
     assert remote["execution"]["scheduler"] == cluster.scheduler_address
     assert _numbers(s_local) == _numbers(s_remote)
@@ -178,7 +178,7 @@ def test_keyboard_interrupt_cli_writes_nothing(tmp_path, capsys, monkeypatch):
     assert main(["study", str(spec), "--out", str(tmp_path / "s")]) == 130
     files = sorted(p.name for p in (tmp_path / "s").rglob("*") if p.is_file())
     assert not (tmp_path / "s" / "summary.json").exists()
-    assert all(f == "cell.json" or study._CHUNK_RE.match(f) for f in files), files  # no temporary file left
+    assert all(f == "cell.json" or study_chunks._CHUNK_RE.match(f) for f in files), files  # no temporary file left
     for p in (tmp_path / "s").rglob("chunk-*.npz"):
         assert np.load(p)["trial"].size == 10  # what is there is complete
 
@@ -207,7 +207,7 @@ rMx = 1
 
 
 def test_study_resumes_to_the_same_summary(tmp_path):
-    spec = study.load_spec(_spec(tmp_path))
+    spec = study_spec.load_spec(_spec(tmp_path))
     assert [c.id for c in spec.cells] == ["paper_paper3_paper_g1", "paper_paper3_x0.5_g1"]
     out = tmp_path / "out"
     logs = []
@@ -218,7 +218,7 @@ def test_study_resumes_to_the_same_summary(tmp_path):
         assert set(z.files) >= {"trial", "est_theta1", "est_rMy", "std_theta2", "chi2", "success", "confirmed"}
         np.testing.assert_array_equal(z["trial"], np.arange(8, 16))
     (cell / "chunk-1.npz").unlink()
-    again = study.run_study(study.load_spec(_spec(tmp_path)), out, log=logs.append)
+    again = study.run_study(study_spec.load_spec(_spec(tmp_path)), out, log=logs.append)
     assert "5 of 6 chunks already on disk, 1 to run (8 identifications)" in logs[-1]
     assert _numbers(first) == _numbers(again)
     assert json.loads((out / "summary.json").read_text())["run"]["chunks_run"] == 1
@@ -230,16 +230,16 @@ def test_study_resumes_to_the_same_summary(tmp_path):
     half = first["cells"][1]
     assert half["rms"]["theta1"] == pytest.approx(c["rms"]["theta1"] / 2, rel=0.05)
     # more trials: the chunks on disk are kept, the last (short) one is recomputed
-    spec30 = study.load_spec(_spec(tmp_path, trials=30))
+    spec30 = study_spec.load_spec(_spec(tmp_path, trials=30))
     todo, on_disk = study.plan(spec30, out)
     assert on_disk == 4 and [(k, a, b) for _, k, a, b in todo] == [(2, 16, 24), (3, 24, 30)] * 2
     # other settings in the same directory are refused
     other = _spec(tmp_path)
     other.write_text(other.read_text().replace("seed = 4", "seed = 5"))
     with pytest.raises(ZerocalError, match="other settings.*seed"):
-        study.run_study(study.load_spec(other), out)
+        study.run_study(study_spec.load_spec(other), out)
     with pytest.raises(ZerocalError, match="other settings.*seed"):
-        study.summarize(study.load_spec(other), out)
+        study.summarize(study_spec.load_spec(other), out)
 
 
 def test_study_cli_runs_and_summarises(tmp_path, capsys):
@@ -277,7 +277,7 @@ def test_study_refuses_bad_spec_with_file_line(tmp_path, body, line, match, caps
     p = tmp_path / "bad.toml"
     p.write_text(body)
     with pytest.raises(ZerocalError, match=match) as exc:
-        study.load_spec(p)
+        study_spec.load_spec(p)
     if match == "two cells":  # the later table of the two
         assert f"{p}:" in str(exc.value)
     else:
@@ -288,7 +288,7 @@ def test_study_refuses_bad_spec_with_file_line(tmp_path, body, line, match, caps
 
 
 def test_example_study_spec_loads():
-    s = study.load_spec(ROOT / "examples" / "study.toml")
+    s = study_spec.load_spec(ROOT / "examples" / "study.toml")
     assert {c.robot_label for c in s.cells} == {"paper", "delta"} and len(s.cells) == 6
     assert {c.design_label for c in s.cells} == {"paper3", "ring6"}
 
@@ -312,7 +312,7 @@ robots = ["delta"]
 [[truth]]
 theta1 = 1
 """)
-    s = study.load_spec(p)
+    s = study_spec.load_spec(p)
     assert [c.id for c in s.cells] == ["paper_poses-poses_scale1-servo0_truth1", "delta_ring4_scale1-servo0_truth1"]
     summ = study.run_study(s, tmp_path / "o", workers=1)
     d = summ["cells"][1]

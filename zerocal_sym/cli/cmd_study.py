@@ -1,7 +1,7 @@
 """A Monte Carlo study: robots x designs x noise levels x truths x trials, chunked and resumable.
 
 The spec (TOML; format in ``docs/montecarlo.md`` and
-:mod:`zerocal_sym.cli.study`) crosses robot files, measurement designs
+:mod:`zerocal_sym.cli.study_spec`) crosses robot files, measurement designs
 (a scheme and n, or a pose file), noise levels (paper, scale-only,
 servo-only, or factors of the paper's noise) and true source errors (tables
 of name = value, deg for angles, mm otherwise).  Every cell runs ``trials``
@@ -41,12 +41,13 @@ def run(args):
     from zerocal_sym.cli import _parallel
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.cli import study as st
+    from zerocal_sym.cli.study_spec import load_spec
     from zerocal_sym.identify.progress import Progress
     from zerocal_sym.io.files import to_json
 
     if args.robot:
         raise ZerocalError("--robot: a study's robots are listed in its spec (robots = [...])")
-    spec = st.load_spec(args.spec)
+    spec = load_spec(args.spec)
     if args.summary is not None:
         if not Path(args.summary).is_dir():
             raise ZerocalError("no such study directory", where=args.summary)

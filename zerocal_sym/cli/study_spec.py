@@ -1,0 +1,375 @@
+"""The study spec (TOML): read and validated into a :class:`Study` of :class:`Cell` s.
+
+A *study* crosses robot files, measurement designs, noise levels and true
+source errors; each combination is a *cell* (the runner is
+:mod:`zerocal_sym.cli.study`).  :func:`load_spec` builds every cell (robots
+loaded, poses checked) before anything runs.
+
+Spec (paths relative to the spec file; angles in degrees, lengths in mm)::
+
+    name = "noise study"          # optional
+    seed = 0                      # optional (default 0)
+    trials = 1000000              # trials per cell
+    chunk = 10000                 # trials per chunk file (default min(10000, trials))
+    params = "paper"              # identified parameters (default: the zero offsets and the MAEMM)
+    streams = "common"            # "common" (default): trial t draws the same numbers in every cell;
+                                  # "independent": each cell its own stream
+    robots = ["paper", "examples/delta.toml"]   # "paper": the built-in robot; label: the file's stem
+    noise = ["paper", "scale-only", 0.5, 2]     # named, or factors of the paper's noise (default ["paper"])
+
+    [[design]]                    # one or more
+    scheme = "auto"               # the robot's boundary scheme (or "paper" / "ring"), with
+    n = 6                         # poses per boundary (default: the scheme's)
+    # poses = "poses.csv"         # or a pose file (instead of scheme/n)
+    # robots = ["delta"]          # only for these robots (labels); label = "ring6" to name it
+
+    [[truth]]                     # one or more; source errors by name, the others zero
+    name = "A"                    # optional (default truth1, truth2, ...)
+    robots = ["delta"]            # optional: only for these robots
+    theta1 = 2
+    theta2 = -1
+    theta3 = 0.5
+
+Errors in the spec are one line naming the file and the line.
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from zerocal_sym.errors import ZerocalError
+from zerocal_sym.identify.parallel import chunk_ranges
+
+SPEC_KEYS = ("name", "seed", "trials", "chunk", "params", "streams", "robots", "noise", "design", "truth")
+DESIGN_KEYS = ("scheme", "n", "poses", "robots", "label")
+TRUTH_RESERVED = ("name", "robots")
+NAMED_NOISE = ("paper", "scale-only", "servo-only", "none")
+DEFAULT_CHUNK = 10000
+CELL_FORMAT = "zerocal study cell v1"
+
+
+class StudySpecError(ZerocalError):
+    """A study spec that is malformed (names the file and line)."""
+
+
+@dataclass
+class Cell:
+    """One combination robot x design x noise x truth."""
+
+    id: str
+    robot: object
+    robot_label: str
+    design_label: str
+    poses: np.ndarray
+    theta: np.ndarray
+    noise_label: str
+    noise: object
+    truth_label: str
+    truth: np.ndarray
+    truth_user: dict
+    params: tuple
+    stream: int
+
+    def settings(self, study) -> dict:
+        """What identifies the cell's results (cell.json); ``trials`` is not part of it."""
+        from zerocal_sym.io.files import json_safe
+
+        r = self.robot
+        return json_safe({
+            "format": CELL_FORMAT, "id": self.id,
+            "robot": {"label": self.robot_label, "name": r.name, "mechanism": r.mechanism_name,
+                      "sha256": r.sha256},
+            "design": self.design_label, "poses_mm": self.poses.tolist(),
+            "noise": {"label": self.noise_label, "sigma_scale_mm": self.noise.sigma_scale_mm,
+                      "sigma_servo_rad": self.noise.sigma_servo_rad},
+            "truth": {"label": self.truth_label, "values": self.truth_user,
+                      "units": {k: r.errors[k].user_unit for k in self.truth_user}},
+            "params": list(self.params), "seed": study.seed, "stream": self.stream, "chunk": study.chunk,
+        })
+
+
+@dataclass
+class Study:
+    """A parsed, validated study spec."""
+
+    path: Path
+    name: str
+    seed: int
+    trials: int
+    chunk: int
+    params: str
+    streams: str
+    cells: list = field(default_factory=list)
+
+    @property
+    def chunks_per_cell(self) -> int:
+        return len(chunk_ranges(self.trials, self.chunk))
+
+
+class _Where:
+    """Line numbers of keys in the spec text (top level, or inside the k-th ``[[table]]``)."""
+
+    def __init__(self, path, text):
+        self.path, self.lines = str(path), text.splitlines()
+
+    def _blocks(self, table):
+        heads = [i for i, ln in enumerate(self.lines) if re.match(rf"\s*\[\[\s*{re.escape(table)}\s*\]\]", ln)]
+        out = []
+        for h in heads:
+            end = next((j for j in range(h + 1, len(self.lines)) if re.match(r"\s*\[", self.lines[j])),
+                       len(self.lines))
+            out.append((h, end))
+        return out
+
+    def __call__(self, key=None, table=None, index=None) -> str:
+        line = None
+        if table is None:
+            end = next((j for j, ln in enumerate(self.lines) if re.match(r"\s*\[", ln)), len(self.lines))
+            rng = range(0, end)
+        else:
+            blocks = self._blocks(table)
+            if index is None or index >= len(blocks):
+                return self.path
+            h, end = blocks[index]
+            line = h + 1
+            rng = range(h + 1, end)
+        if key is not None:
+            for j in rng:
+                if re.match(rf"\s*(\"?){re.escape(key)}\1\s*=", self.lines[j]):
+                    line = j + 1
+                    break
+        return f"{self.path}:{line}" if line else self.path
+
+
+def _slug(s: str) -> str:
+    s = re.sub(r"[^A-Za-z0-9.+-]+", "-", str(s)).strip("-.")
+    return s or "x"
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_num(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(float(v))
+
+
+def _noise_levels(raw, where):
+    from zerocal_sym.model.noise import NoiseModel
+
+    if not isinstance(raw, list) or not raw:
+        raise StudySpecError("noise must be a non-empty list of paper | scale-only | servo-only | none, factors "
+                             "of the paper's noise, or {scale = a, servo = b} tables", where=where("noise"))
+    out = []
+    for v in raw:
+        if isinstance(v, str):
+            if v not in NAMED_NOISE:
+                raise StudySpecError(f"unknown noise level {v!r} (named: {', '.join(NAMED_NOISE)}; or a factor "
+                                     "of the paper's noise)", where=where("noise"))
+            out.append((v, NoiseModel.named(v)))
+        elif _is_num(v):
+            if v < 0:
+                raise StudySpecError(f"noise factor {v!r} must be >= 0", where=where("noise"))
+            out.append((f"x{float(v):g}", NoiseModel.paper(float(v), float(v))))
+        elif isinstance(v, dict):
+            bad = [k for k in v if k not in ("scale", "servo")]
+            vals = [v.get("scale", 1.0), v.get("servo", 1.0)]
+            if bad or not all(_is_num(x) and x >= 0 for x in vals):
+                raise StudySpecError(f"noise table {v!r}: keys scale and servo, factors >= 0 of the paper's "
+                                     "two noise terms", where=where("noise"))
+            out.append((f"scale{float(vals[0]):g}-servo{float(vals[1]):g}", NoiseModel.paper(*map(float, vals))))
+        else:
+            raise StudySpecError(f"noise level {v!r}: a name or a number", where=where("noise"))
+    labels = [lab for lab, _ in out]
+    dup = sorted({lab for lab in labels if labels.count(lab) > 1})
+    if dup:
+        raise StudySpecError(f"noise level {dup[0]} given twice", where=where("noise"))
+    return out
+
+
+def _robots(raw, base, where):
+    from zerocal_sym.model.robot import load_robot, paper_robot
+
+    if not isinstance(raw, list) or not raw or not all(isinstance(r, str) and r for r in raw):
+        raise StudySpecError('robots must be a non-empty list of robot files (or "paper" for the built-in robot)',
+                             where=where("robots"))
+    out = {}
+    for r in raw:
+        if r == "paper":
+            label, robot = "paper", paper_robot()
+        else:
+            p = Path(r) if Path(r).is_absolute() else base / r
+            try:
+                robot = load_robot(p)
+            except ZerocalError as exc:
+                raise StudySpecError(f"robot {r!r}: {exc}", where=where("robots")) from None
+            label = _slug(p.stem)
+        if label in out:
+            raise StudySpecError(f"two robots with the label {label!r} (a file's stem): rename one",
+                                 where=where("robots"))
+        out[label] = robot
+    return out
+
+
+def _filter(tab, labels, where_key):
+    f = tab.get("robots")
+    if f is None:
+        return None
+    if not isinstance(f, list) or not all(isinstance(x, str) for x in f):
+        raise StudySpecError("robots must be a list of robot labels", where=where_key("robots"))
+    unknown = [x for x in f if x not in labels]
+    if unknown:
+        raise StudySpecError(f"unknown robot label {unknown[0]!r} (labels: {', '.join(labels)})",
+                             where=where_key("robots"))
+    return set(f)
+
+
+def _design_poses(tab, robot, base, wk):
+    """(label, poses) of one [[design]] table for one robot."""
+    from zerocal_sym.cli._common import check_scheme, scheme_poses
+    from zerocal_sym.io.poses import load_poses
+
+    if "poses" in tab:
+        p = Path(tab["poses"]) if Path(tab["poses"]).is_absolute() else base / tab["poses"]
+        try:
+            P = load_poses(p, robot)
+        except ZerocalError as exc:
+            raise StudySpecError(f"poses for robot {robot.name!r}: {exc}", where=wk("poses")) from None
+        return tab.get("label") or f"poses-{_slug(p.stem)}", P
+    scheme = tab.get("scheme", "auto")
+    try:
+        scheme = check_scheme(robot, None if scheme == "auto" else scheme, option="scheme =")
+        P, n = scheme_poses(robot, scheme, tab.get("n"), option="scheme =")
+    except ZerocalError as exc:
+        raise StudySpecError(f"robot {robot.name!r}: {exc.message}", where=wk("scheme" if "scheme" in tab else
+                                                                            "n" if "n" in tab else None)) from None
+    return tab.get("label") or f"{scheme}{n}", P
+
+
+def load_spec(path) -> Study:
+    """Read and validate a study spec (TOML); every cell is built (robots loaded, poses checked).
+
+    Raises
+    ------
+    StudySpecError
+        Naming the spec file and the line.
+    """
+    from zerocal_sym.cli._common import parse_named_values
+    from zerocal_sym.model import kinematics as kin
+
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise StudySpecError("study spec not found", where=str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise StudySpecError(f"cannot read the study spec: {exc}", where=str(path)) from None
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        m = re.search(r"line (\d+)", str(exc))
+        raise StudySpecError(f"not valid TOML: {exc}", where=f"{path}:{m.group(1)}" if m else str(path)) from None
+    where = _Where(path, text)
+    base = path.parent
+    for k in raw:
+        if k not in SPEC_KEYS:
+            raise StudySpecError(f"unknown key '{k}' (allowed: {', '.join(SPEC_KEYS)})", where=where(k))
+    if "trials" not in raw:
+        raise StudySpecError("missing key 'trials' (trials per cell)", where=str(path))
+    trials = raw["trials"]
+    if not _is_int(trials) or trials < 1:
+        raise StudySpecError(f"trials must be a positive integer, got {trials!r}", where=where("trials"))
+    seed = raw.get("seed", 0)
+    if not _is_int(seed) or seed < 0:
+        raise StudySpecError(f"seed must be a non-negative integer, got {seed!r}", where=where("seed"))
+    chunk = raw.get("chunk", min(DEFAULT_CHUNK, trials))
+    if not _is_int(chunk) or chunk < 1:
+        raise StudySpecError(f"chunk must be a positive integer, got {chunk!r}", where=where("chunk"))
+    params = raw.get("params", "paper")
+    if not isinstance(params, str):
+        raise StudySpecError("params must be a string (paper | all | names joined by , or +)", where=where("params"))
+    streams = raw.get("streams", "common")
+    if streams not in ("common", "independent"):
+        raise StudySpecError(f"streams must be 'common' or 'independent', got {streams!r}", where=where("streams"))
+    name = raw.get("name", path.stem)
+    if not isinstance(name, str):
+        raise StudySpecError("name must be a string", where=where("name"))
+    robots = _robots(raw.get("robots"), base, where)
+    noises = _noise_levels(raw.get("noise", ["paper"]), where)
+    designs, truths = raw.get("design"), raw.get("truth")
+    for key, tabs in (("design", designs), ("truth", truths)):
+        if not isinstance(tabs, list) or not tabs or not all(isinstance(t, dict) for t in tabs):
+            raise StudySpecError(f"at least one [[{key}]] table is needed", where=where(key))
+    study = Study(path=path, name=name, seed=seed, trials=trials, chunk=chunk, params=params, streams=streams)
+    labels = list(robots)
+    for rl, robot in robots.items():
+        try:
+            names = robot.errors.resolve(params)
+        except ValueError as exc:
+            raise StudySpecError(f"params for robot {rl!r}: {exc}", where=where("params")) from None
+        for di, dt in enumerate(designs):
+            def wd(key, _i=di):
+                return where(key, "design", _i)
+
+            for k, v in dt.items():
+                if k not in DESIGN_KEYS:
+                    raise StudySpecError(f"unknown key '{k}' in [[design]] (allowed: {', '.join(DESIGN_KEYS)})",
+                                         where=wd(k))
+            if "poses" in dt and ("scheme" in dt or "n" in dt):
+                raise StudySpecError("give poses = FILE or scheme/n, not both", where=wd("poses"))
+            for k, ok in (("poses", lambda v: isinstance(v, str)), ("scheme", lambda v: isinstance(v, str)),
+                          ("label", lambda v: isinstance(v, str) and v), ("n", lambda v: _is_int(v) and v >= 2)):
+                if k in dt and not ok(dt[k]):
+                    raise StudySpecError(f"{k} = {dt[k]!r}: expected "
+                                         + ("an integer >= 2" if k == "n" else "a string"), where=wd(k))
+            flt = _filter(dt, labels, wd)
+            if flt is not None and rl not in flt:
+                continue
+            dlabel, P = _design_poses(dt, robot, base, wd)
+            try:
+                theta = kin.check_poses(robot, P)
+            except ZerocalError as exc:
+                raise StudySpecError(f"robot {rl!r}: {exc}", where=wd(None)) from None
+            if P.shape[0] - 1 < len(names):
+                raise StudySpecError(f"robot {rl!r}: {P.shape[0]} poses give {P.shape[0] - 1} changes, fewer than "
+                                     f"the {len(names)} parameters", where=wd(None))
+            for ti, tt in enumerate(truths):
+                def wt(key, _i=ti):
+                    return where(key, "truth", _i)
+
+                flt = _filter(tt, labels, wt)
+                if flt is not None and rl not in flt:
+                    continue
+                tlabel = tt.get("name", f"truth{ti + 1}")
+                if not isinstance(tlabel, str) or not tlabel:
+                    raise StudySpecError("name must be a non-empty string", where=wt("name"))
+                values = {k: v for k, v in tt.items() if k not in TRUTH_RESERVED}
+                for k, v in values.items():
+                    if not _is_num(v):
+                        raise StudySpecError(f"{k} = {v!r}: expected a finite number (deg for angles, mm otherwise)",
+                                             where=wt(k))
+                try:
+                    user = parse_named_values([f"{k}={v}" for k, v in values.items()], robot, "truth")
+                except ZerocalError as exc:
+                    bad = next((k for k in values if k not in robot.errors.names), None)
+                    raise StudySpecError(f"robot {rl!r}: {exc.message}", where=wt(bad)) from None
+                for nl, noise in noises:
+                    cid = "_".join(_slug(x) for x in (rl, dlabel, nl, tlabel))
+                    stream = 0 if streams == "common" else int.from_bytes(
+                        hashlib.sha256(cid.encode()).digest()[:4], "little")
+                    if any(c.id == cid for c in study.cells):
+                        raise StudySpecError(f"two cells named {cid!r}: give the [[design]]/[[truth]] tables "
+                                             "distinct labels/names", where=wt("name") if "name" in tt else wd(None))
+                    study.cells.append(Cell(cid, robot, rl, dlabel, P, theta, nl, noise, tlabel,
+                                            robot.errors.from_user(user), user, names, stream))
+    if not study.cells:
+        raise StudySpecError("no cell: every [[design]] or [[truth]] is filtered out for every robot",
+                             where=str(path))
+    return study
+
