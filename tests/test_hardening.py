@@ -511,7 +511,7 @@ def test_ctrl_c_inside_an_extension_or_an_import(capsys, monkeypatch, exc):
 # =========================================================================== 4. scale (the data side)
 
 def test_duplicate_check_matches_the_pairwise_scan():
-    from zerocal_sym.io.measurements import _first_duplicate_scan, first_duplicate
+    from zerocal_sym.io.duplicates import _first_duplicate_scan, first_duplicate
 
     rng = np.random.default_rng(7)
     for _ in range(2000):
