@@ -196,3 +196,63 @@ def test_accuracy_scale_only_vs_paper_noise(robot, poses):
     paper = rms_delta(NoiseModel.paper(), 40)
     assert 0.025 < scale < 0.08
     assert 0.25 < paper < 0.8
+
+
+# ---------------------------------------------------------------- loops in lockstep, a shared first round
+def test_calibration_loops_in_lockstep_are_the_single_loops(robot, poses):
+    """calibration_loops with the batched TSVD = calibration_loop per seed (bit for bit), the first round shared."""
+    from functools import partial
+
+    from zerocal_sym.errors import IdentificationError
+    from zerocal_sym.identify.loop import calibration_loops
+    from zerocal_sym.identify.tsvd import identify_tsvd, identify_tsvd_many
+
+    plant = VirtualPlant(robot, group_errors(1))
+    noise = NoiseModel.paper()
+    th = kin.ik(robot, poses)
+    lean = partial(identify_tsvd, diagnostics=False)
+    seeds = [np.random.SeedSequence([4, k]) for k in range(7)]
+    single = [calibration_loop(robot, plant, poses, identify=lean, noise=noise, rng=np.random.default_rng(ss),
+                               max_iter=6, kappa=False) for ss in seeds]
+    firsts, rngs = [], []
+    for ss in seeds:  # the first round simulated outside, the loop continuing the same generator
+        g = np.random.default_rng(ss)
+        firsts.append(simulate_round(robot, plant, poses, None, noise, g, theta=th))
+        rngs.append(g)
+    one = calibration_loop(robot, plant, poses, identify=lean, noise=noise, rng=rngs[0], max_iter=6, kappa=False,
+                           theta=th, first=firsts[0])
+    np.testing.assert_array_equal(one.compensation_deg, single[0].compensation_deg)
+    rngs[0], firsts[0] = np.random.default_rng(seeds[0]), None  # loop 0 simulates its own first round
+    calls = []
+
+    def many(robot_, rounds, priors):
+        calls.append(len(rounds))
+        return identify_tsvd_many(robot_, rounds, priors)
+
+    runs = calibration_loops(robot, plant, poses, many, rngs, noise=noise, max_iter=6, kappa=False, theta=th,
+                             firsts=firsts)
+    assert calls[0] == len(seeds) and calls == sorted(calls, reverse=True)
+    for (loop, n_id, secs), ref in zip(runs, single):
+        assert n_id == len(ref.history) == len(loop.history)
+        assert secs > 0 and loop.converged == ref.converged and loop.iterations == ref.iterations
+        np.testing.assert_array_equal(loop.compensation_deg, ref.compensation_deg)
+        np.testing.assert_array_equal(loop.maemm_mm, ref.maemm_mm)
+        assert [h.mu_deg for h in loop.history] == [h.mu_deg for h in ref.history]
+
+    def fails_in_round_2(robot_, rounds, priors):  # the second loop's second identification fails
+        out = identify_tsvd_many(robot_, rounds, priors)
+        if np.any(priors[0][:2]) and not failed:
+            failed.append(1)
+            out[1] = IdentificationError("no")
+        return out
+
+    failed = []
+
+    runs = calibration_loops(robot, plant, poses, fails_in_round_2, [np.random.default_rng(s) for s in seeds[:3]],
+                             noise=noise, max_iter=6, catch=(IdentificationError,))
+    assert isinstance(runs[1][0], IdentificationError) and runs[1][1] == 2
+    assert not isinstance(runs[0][0], Exception) and not isinstance(runs[2][0], Exception)
+    failed.clear()
+    with pytest.raises(IdentificationError):  # not caught: propagates
+        calibration_loops(robot, plant, poses, fails_in_round_2, [np.random.default_rng(s) for s in seeds[:3]],
+                          noise=noise, catch=())

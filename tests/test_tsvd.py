@@ -190,3 +190,100 @@ def test_poses_on_one_line(robot, line):
     y = np.full(7, 700.0) if line == "horizontal" else 700 + 0.3 * x
     with pytest.raises(IdentificationError, match="one straight line"):
         identify_tsvd(robot, _meas(robot, np.column_stack([x, y])))
+
+
+# ---------------------------------------------------------------- without diagnostics, many rounds at once
+def _rounds(robot, n, seed=0):
+    """Noisy rounds of the paper's poses (and of 8 poses) at random compensations and priors."""
+    from zerocal_sym.paper.tables import group_errors
+
+    rng = np.random.default_rng(seed)
+    plant = VirtualPlant(robot, group_errors(2))
+    rounds, priors = [], []
+    for i in range(n):
+        P = paper_poses(robot, 3 if i % 3 else 4)
+        prior = np.zeros(len(robot.errors))
+        prior[[0, 1, 10, 11]] = rng.normal(0, [0.03, 0.03, 1.0, 1.0])
+        rounds.append(simulate_round(robot, plant, P, prior[:2], NoiseModel.paper(), rng))
+        priors.append(prior)
+    return rounds, priors
+
+
+def _same(a, b):
+    """Two outcomes of identify_tsvd(diagnostics=False) are the same: the numbers bit for bit, or the same error."""
+    if isinstance(a, Exception) or isinstance(b, Exception):
+        return type(a) is type(b) and str(a) == str(b)
+    return (np.array_equal(a.estimate, b.estimate) and a.status == b.status and a.success == b.success
+            and a.info["kappa"] == b.info["kappa"] and np.array_equal(a.info["increment"], b.info["increment"])
+            and np.array_equal(a.info["singular_values"], b.info["singular_values"])
+            and np.array_equal(a.info["nominal_poses"], b.info["nominal_poses"]))
+
+
+def _alone(robot, meas, prior, **kw):
+    try:
+        return identify_tsvd(robot, meas, prior, diagnostics=False, **kw)
+    except Exception as exc:  # noqa: BLE001
+        return exc
+
+
+def test_without_diagnostics_the_same_estimate(robot):
+    rounds, priors = _rounds(robot, 6, seed=3)
+    for meas, prior in zip(rounds, priors):
+        full = identify_tsvd(robot, meas, prior)
+        lean = identify_tsvd(robot, meas, prior, diagnostics=False)
+        np.testing.assert_array_equal(lean.estimate, full.estimate)
+        assert lean.success and full.success and lean.info["kappa"] == full.info["kappa"]
+        assert lean.covariance is None and lean.std_kind == "lower bound" and "fit" not in lean.info
+        assert "fit not checked" in lean.status and lean.info["diagnostics"] is False
+
+
+def test_identify_tsvd_many_is_one_by_one(robot):
+    """The batch gives each round's numbers bit for bit, and each bad round the error it raises alone."""
+    from zerocal_sym.identify.tsvd import identify_tsvd_many
+
+    rounds, priors = _rounds(robot, 13)
+    P = paper_poses(robot, 3)
+    bad_reading = _meas(robot, P)
+    bad_reading.readings[3] = np.nan
+    line = np.column_stack([np.linspace(-200, 200, 6), np.full(6, 700.0)])
+    collinear = np.column_stack([np.zeros(6), np.linspace(632, 782, 6)])
+    rounds[2:2] = [bad_reading, _meas(robot, line), _meas(robot, collinear), _meas(robot, P[:4]), _meas(robot, P)]
+    priors[2:2] = [None, None, None, None, np.zeros(3)]  # the last: a prior of the wrong length
+    out = identify_tsvd_many(robot, rounds, priors)
+    alone = [_alone(robot, m, p) for m, p in zip(rounds, priors)]
+    assert [type(a).__name__ for a in alone[2:7]] == ["IdentificationError"] * 4 + ["ValueError"]
+    assert sum(isinstance(a, Exception) for a in alone) == 5
+    for a, b in zip(out, alone):
+        assert _same(a, b), (a, b)
+    for kw in ({"t": 3}, {"rule": "gcv"}):
+        for a, b in zip(identify_tsvd_many(robot, rounds, priors, **kw), [_alone(robot, m, p, **kw)
+                                                                            for m, p in zip(rounds, priors)]):
+            assert _same(a, b), (kw, a, b)
+    assert identify_tsvd_many(robot, []) == []
+    with pytest.raises(ValueError, match="priors"):
+        identify_tsvd_many(robot, rounds[:2], priors[:1])
+
+
+def test_identify_tsvd_many_falls_back_to_one_by_one(robot, monkeypatch):
+    """When the batch itself fails (e.g. an unreachable pose among them), each round is identified alone."""
+    from zerocal_sym.errors import PoseError
+    from zerocal_sym.identify import linear
+    from zerocal_sym.identify.tsvd import identify_tsvd_many
+
+    rounds, priors = _rounds(robot, 5, seed=1)
+    alone = [_alone(robot, m, p) for m, p in zip(rounds, priors)]
+    real = linear.identification_matrix
+
+    def only_one_round(robot_, P, *a, **kw):
+        if len(P) > 8:
+            raise PoseError("pose (1, 2) mm is unreachable")
+        return real(robot_, P, *a, **kw)
+
+    monkeypatch.setattr(linear, "identification_matrix", only_one_round)
+    for a, b in zip(identify_tsvd_many(robot, rounds, priors), alone):
+        assert _same(a, b)
+    # Ctrl-C that C code turned into an error is not a round's outcome: it propagates
+    monkeypatch.setattr(linear, "identification_matrix", lambda *a, **kw: (_ for _ in ()).throw(
+        RuntimeError("KeyboardInterrupt")))
+    with pytest.raises(RuntimeError, match="KeyboardInterrupt"):
+        identify_tsvd_many(robot, rounds, priors)

@@ -15,6 +15,7 @@ identification, i.e. the RMS of the ``j``-th increment; defined from ``j = 2``.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -166,7 +167,8 @@ def _misfit_only(res) -> bool:
 
 
 def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rng=None, mu0_deg=0.1,
-                     max_iter=20, maemm_prior=None, run_all=False, kappa: bool = True, theta=None) -> LoopResult:
+                     max_iter=20, maemm_prior=None, run_all=False, kappa: bool = True, theta=None,
+                     first=None) -> LoopResult:
     """The paper's iterative identification and compensation (Eq. 30-33).
 
     Each round commands ``IK(poses) - compensation``, measures, and calls
@@ -205,6 +207,13 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
         identification matrix less per round; the Monte Carlo does not use it).
     theta : ndarray, shape (K, m), optional
         ``IK(poses)`` if already known.
+    first : Measurements, optional
+        The first round, already simulated (``simulate_round(robot, plant,
+        poses, None, noise, g)``) with a generator ``g`` that ``rng`` continues
+        (``rng`` in the state ``g`` was left in): the loop starts from it
+        instead of simulating it, with the same result.  Several loops of a
+        Monte Carlo trial share their first round this way.  Identifiers must
+        not modify the measurements.
 
     Returns
     -------
@@ -212,6 +221,83 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
     """
     if max_iter < 1:
         raise ValueError("max_iter must be >= 1")
+    steps = _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_all, kappa, theta, first)
+    try:
+        meas, prior = next(steps)
+        while True:
+            meas, prior = steps.send(identify(robot, meas, prior))
+    except StopIteration as stop:
+        return stop.value
+
+
+def calibration_loops(robot, plant, poses, identify_many, rngs, noise=None, mu0_deg=0.1, max_iter=20,
+                      maemm_prior=None, run_all=False, kappa: bool = True, theta=None, firsts=None,
+                      catch=(Exception,)) -> list:
+    """Several :func:`calibration_loop` in lockstep, each round's identifications in one call.
+
+    Loop ``i`` is ``calibration_loop(robot, plant, poses, identify, noise,
+    rngs[i], ..., first=firsts[i])`` with ``identify`` one round of
+    ``identify_many(robot, rounds, priors)``, which identifies the rounds of
+    all loops still running at once and returns per round its result or the
+    exception raised for it (e.g.
+    :func:`zerocal_sym.identify.tsvd.identify_tsvd_many`): the same loops, the
+    batch only saves time.
+
+    Parameters
+    ----------
+    identify_many : callable
+        ``identify_many(robot, rounds, priors) -> list`` of results or exceptions.
+    rngs : sequence of numpy Generators (or seeds)
+        One per loop.
+    firsts : sequence of Measurements or None, optional
+        Each loop's first round (see ``first`` of :func:`calibration_loop`).
+    catch : tuple of exception types
+        Exceptions that end one loop (its entry is the exception); others propagate.
+
+    Returns
+    -------
+    list of (outcome, identifications, seconds)
+        Per loop: its :class:`LoopResult` or the exception that ended it;
+        the identifications it asked for (a failed one included); its share
+        of the time spent in ``identify_many`` (each call's time split
+        evenly over its rounds).
+    """
+    if max_iter < 1:
+        raise ValueError("max_iter must be >= 1")
+    n = len(rngs)
+    firsts = [None] * n if firsts is None else list(firsts)
+    out = [None] * n
+    calls, secs = [0] * n, [0.0] * n
+    pending = {}  # loop -> (steps, meas, prior)
+
+    def step(i, steps, value=None, start=False):
+        try:
+            meas, prior = next(steps) if start else (steps.throw(value) if isinstance(value, BaseException)
+                                                     else steps.send(value))
+            pending[i] = (steps, meas, prior)
+        except StopIteration as stop:
+            out[i] = stop.value
+        except catch as exc:
+            out[i] = exc
+
+    for i in range(n):
+        step(i, _steps(robot, plant, poses, noise, rngs[i], mu0_deg, max_iter, maemm_prior, run_all, kappa,
+                       theta, firsts[i]), start=True)
+    while pending:
+        live = sorted(pending)
+        t0 = time.perf_counter()
+        results = identify_many(robot, [pending[i][1] for i in live], [pending[i][2] for i in live])
+        dt = (time.perf_counter() - t0) / len(live)
+        for i, res in zip(live, results):
+            calls[i] += 1
+            secs[i] += dt
+            step(i, pending.pop(i)[0], res)
+    return list(zip(out, calls, secs))
+
+
+def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_all, kappa, theta, first):
+    """The loop as a generator: yields ``(meas, prior)`` per identification, is sent its result;
+    returns the :class:`LoopResult` (an identification that raised is thrown in)."""
     rng = np.random.default_rng(rng)
     errors = robot.errors
     offs, meas_names = errors.zero_offsets, errors.measuring
@@ -221,15 +307,19 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
     out = LoopResult(compensation_deg=np.zeros(robot.m), maemm_mm=np.zeros(robot.n))
     comp = np.zeros(robot.m)
     theta = kin.ik(robot, poses) if theta is None else theta
+    i_off, i_meas = [errors.index(n) for n in offs], [errors.index(n) for n in meas_names]  # take / put
     for j in range(1, max_iter + 1):
-        meas = simulate_round(robot, plant, poses, comp, noise, rng, theta=theta)
-        res = identify(robot, meas, prior.copy())
+        if j == 1 and first is not None:
+            meas = first
+        else:
+            meas = simulate_round(robot, plant, poses, comp, noise, rng, theta=theta)
+        res = yield meas, prior.copy()
         if not getattr(res, "success", True):
             if not _misfit_only(res):
                 raise IdentificationError(f"identification {j} failed: {res.status}")
             out.misfits += 1
         new = np.array([res.value(n) for n in offs])
-        maemm = np.array([res.value(n, v) for n, v in zip(meas_names, errors.take(prior, meas_names))])
+        maemm = np.array([res.value(n, v) for n, v in zip(meas_names, prior[i_meas])])
         inc = new - comp
         mu = None if j == 1 else float(np.degrees(np.sqrt(np.mean(inc**2))))
         kap = float(res.info.get("kappa", np.nan)) if isinstance(res.info, dict) else float("nan")
@@ -238,7 +328,8 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
             kap = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
         out.history.append(IterationRecord(res, np.degrees(new), np.degrees(inc), mu, kap, maemm.copy()))
         comp = new
-        prior = errors.put(errors.put(prior, offs, new), meas_names, maemm)
+        prior = prior.copy()
+        prior[i_off], prior[i_meas] = new, maemm
         if not out.converged:
             out.compensation_deg, out.maemm_mm, out.iterations = np.degrees(new), maemm.copy(), j
             if mu is not None and mu < mu0_deg:

@@ -21,9 +21,17 @@ round first:
 
 The loops draw their later rounds from the same seed, so the loop methods
 share the first round but not (after their compensations differ) the later
-ones.  Errors are reported in our frame, or through a ``report`` transform
-(the paper's Table 2 frame: :func:`zerocal_sym.paper.compare.compare`; RMS
-values do not depend on the frame).
+ones.  Within a chunk the TSVD loops of all trials run in lockstep, each
+round's identifications in one batch
+(:func:`~zerocal_sym.identify.loop.calibration_loops` with
+:func:`~zerocal_sym.identify.tsvd.identify_tsvd_many`, the estimate without
+TSVD's diagnostics: the same numbers as one loop per trial, bit for bit);
+their time per identification is their share of the batch.  The scipy
+reference evaluates the residuals through zero-copy callbacks
+(:func:`scipy_identify`).  Errors are reported in our frame, or through a
+``report`` transform (the paper's Table 2 frame:
+:func:`zerocal_sym.paper.compare.compare`; RMS values do not depend on the
+frame).
 """
 from __future__ import annotations
 
@@ -35,7 +43,7 @@ import numpy as np
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
-from zerocal_sym.identify.loop import calibration_loop, simulate_round
+from zerocal_sym.identify.loop import calibration_loop, calibration_loops, simulate_round
 from zerocal_sym.identify.parallel import (Progress, Stats, check_execution, chunk_ranges, default_chunk,
                                           describe_scheduler, run_chunks)
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
@@ -69,11 +77,16 @@ def _scipy_least_squares():
     return least_squares
 
 
-def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
+def scipy_identify(robot, meas, params="paper", noise=None, prior=None, callbacks: str = "fast"):
     """``scipy.optimize.least_squares`` on the problem Ipopt solves (reference).
 
     The whitened, scaled residuals of :func:`zerocal_sym.identify.nlls.residual_problem`
-    (weights at ``prior``), Levenberg-Marquardt from ``prior``.
+    (weights at ``prior``), Levenberg-Marquardt from ``prior``.  ``callbacks``
+    (passed to ``residual_problem``): ``"fast"`` (default) evaluates the CasADi
+    residuals and Jacobian through zero-copy buffers, ``"plain"`` through the
+    ordinary ``Function`` call (numpy <-> DM conversions, ~0.1-0.2 ms per call,
+    most of the solver time at K = 6); the values, hence the estimate, are the
+    same bit for bit, only ``time_s`` differs.
 
     Returns
     -------
@@ -85,7 +98,7 @@ def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
     from zerocal_sym.identify.nlls import residual_problem
 
     least_squares = _scipy_least_squares()
-    fun, jac, scale = residual_problem(robot, meas, params, noise, prior)
+    fun, jac, scale = residual_problem(robot, meas, params, noise, prior, callbacks=callbacks)
     p0 = robot.errors.zeros() if prior is None else np.asarray(prior, float)
     z0 = robot.errors.take(p0, robot.errors.resolve(params)) * scale
     t = time.perf_counter()
@@ -93,6 +106,31 @@ def scipy_identify(robot, meas, params="paper", noise=None, prior=None):
     dt = time.perf_counter() - t
     return sol.x / scale, {"success": bool(sol.success), "nfev": int(sol.nfev), "cost": float(sol.cost),
                            "time_s": dt}
+
+
+def _continued(ss, state):
+    """``np.random.default_rng(ss)`` moved to ``state`` (a generator's ``bit_generator.state``)."""
+    bg = np.random.PCG64(ss)
+    bg.state = state
+    return np.random.Generator(bg)
+
+
+def _record_loop(record, m, loop, n_id, t_id, methods, paper4):
+    """Record loop method ``m`` (a LoopResult, None if it failed) and, for ``tsvd-loop``, its first identification
+    as ``tsvd``; ``n_id`` identifications took ``t_id`` seconds."""
+    if m == "tsvd-loop" and "tsvd" in methods:
+        res1 = loop.history[0].result if loop is not None and loop.history else None
+        if res1 is None or not res1.success:
+            record("tsvd", None, 0.0)
+        else:
+            record("tsvd", np.array([res1.value(n) for n in paper4]), t_id / max(1, n_id))
+    if m not in methods:
+        return
+    if loop is None:
+        record(m, None, t_id, n_id)
+        return
+    est = np.concatenate([np.radians(loop.compensation_deg), loop.maemm_mm])
+    record(m, est, t_id, n_id, loop.converged)
 
 
 def _identity_report(values, which):
@@ -145,7 +183,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
     """
     from zerocal_sym.identify.batch import identify_batch
     from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
-    from zerocal_sym.identify.tsvd import identify_tsvd
+    from zerocal_sym.identify.tsvd import identify_tsvd_many
 
     robot, methods, names, noise = task.robot, task.methods, task.names, task.noise
     errors = robot.errors
@@ -172,33 +210,31 @@ def _compare_chunk(task: _CompareTask) -> dict:
         r.M.append(report(e[m_:], "maemm"))
         r.comp.append(est4[:m_])
 
+    trials = []  # per trial: its seed, first round and the generator state after it
     for trial in range(task.start, task.stop):
         ss = np.random.SeedSequence([task.seed, task.stream, trial])
-        meas1 = simulate_round(robot, plant, task.poses, None, noise, np.random.default_rng(ss), theta=th0)
-        for m in ("tsvd-loop", "nlls-loop", "nlls-seq"):
-            if m not in methods and not (m == "tsvd-loop" and "tsvd" in methods):
-                continue
-            ident = _Timed(identify_tsvd if m == "tsvd-loop" else
-                           make_nlls_identifier(params=names, noise=noise, sequential=(m == "nlls-seq")))
-            try:
-                loop = calibration_loop(robot, plant, task.poses, identify=ident, noise=noise,
-                                        rng=np.random.default_rng(ss), mu0_deg=task.mu0_deg,
-                                        max_iter=task.max_iter, kappa=False, theta=th0)
-            except (IdentificationError, ZerocalError):
-                loop = None
-            if m == "tsvd-loop" and "tsvd" in methods:
-                res1 = loop.history[0].result if loop is not None and loop.history else None
-                if res1 is None or not res1.success:
-                    record("tsvd", None, 0.0)
-                else:
-                    record("tsvd", np.array([res1.value(n) for n in paper4]), ident.t / max(1, ident.n))
+        rng1 = np.random.default_rng(ss)
+        meas1 = simulate_round(robot, plant, task.poses, None, noise, rng1, theta=th0)
+        trials.append((ss, meas1, rng1.bit_generator.state))  # every loop: this first round, then its own draws
+    loop_kw = dict(noise=noise, mu0_deg=task.mu0_deg, max_iter=task.max_iter, kappa=False, theta=th0)
+    if "tsvd-loop" in methods or "tsvd" in methods:  # the chunk's TSVD loops in lockstep, one batch per round
+        runs = calibration_loops(robot, plant, task.poses, identify_tsvd_many,
+                                 [_continued(ss, st) for ss, _, st in trials], firsts=[m1 for _, m1, _ in trials],
+                                 catch=(IdentificationError, ZerocalError), **loop_kw)
+        for loop, n_id, t_id in runs:
+            loop = None if isinstance(loop, BaseException) else loop
+            _record_loop(record, "tsvd-loop", loop, n_id, t_id, methods, paper4)
+    for ss, meas1, after1 in trials:
+        for m in ("nlls-loop", "nlls-seq"):
             if m not in methods:
                 continue
-            if loop is None:
-                record(m, None, ident.t, ident.n)
-                continue
-            est = np.concatenate([np.radians(loop.compensation_deg), loop.maemm_mm])
-            record(m, est, ident.t, ident.n, loop.converged)
+            ident = _Timed(make_nlls_identifier(params=names, noise=noise, sequential=(m == "nlls-seq")))
+            try:
+                loop = calibration_loop(robot, plant, task.poses, identify=ident, rng=_continued(ss, after1),
+                                        first=meas1, **loop_kw)
+            except (IdentificationError, ZerocalError):
+                loop = None
+            _record_loop(record, m, loop, ident.n, ident.t, methods, paper4)
         if "nlls" in methods:
             first.append(meas1.readings)
         if "scipy" in methods:

@@ -123,9 +123,14 @@ def tsvd_solve(G, b, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL, noise_std=Non
     b = np.asarray(b, float)
     if G.ndim != 2 or b.shape != (G.shape[0],):
         raise ValueError(f"G must be (m, p) and b (m,), got {G.shape} and {b.shape}")
-    if not (np.all(np.isfinite(G)) and np.all(np.isfinite(b))):
+    if not (np.isfinite(G).all() and np.isfinite(b).all()):
         raise IdentificationError("G or b contains NaN or inf")
     U, s, Vt = np.linalg.svd(G, full_matrices=False)
+    return _solve_svd(U, s, Vt, b, G.shape[0], t, rule, rtol, noise_std, tau)
+
+
+def _solve_svd(U, s, Vt, b, m, t, rule, rtol, noise_std, tau) -> TSVDSolution:
+    """:func:`tsvd_solve` from the thin SVD ``U, s, Vt`` of the checked G (m rows)."""
     r = s.size
     beta = U.T @ b
     # ||r_t||^2 = ||b||^2 - sum_{i<=t} beta_i^2 (exact for the thin SVD plus the orthogonal part)
@@ -133,17 +138,16 @@ def tsvd_solve(G, b, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL, noise_std=Non
     perp = max(float(b @ b) - float(beta @ beta), 0.0)
     res2 = tail + perp
     criterion = None
-    positive = int(np.sum(s > 0))
+    positive = int(np.count_nonzero(s > 0))
     if t is not None:
         t = int(t)
         if not 1 <= t <= r:
             raise ValueError(f"truncation t must be in 1..{r}, got {t}")
         used = "fixed"
     elif rule == "threshold":
-        t = int(np.sum(s > rtol * s[0])) if s[0] > 0 else 0
+        t = int(np.count_nonzero(s > rtol * s[0])) if s[0] > 0 else 0
         used = rule
     elif rule == "gcv":
-        m = G.shape[0]
         ts = np.arange(r + 1)
         criterion = np.full(r + 1, np.inf)
         ok = (ts < m) & (ts <= positive)
@@ -180,14 +184,15 @@ def _validate(meas, robot, p):
         raise IdentificationError(f"too few poses: K = {K} < {p + 1} ({p} parameters are identified from K - 1 "
                                   "measured changes)", where=meas.source)
     for name, arr in (("commanded joint angles", th), ("reading", rd)):
-        bad = np.flatnonzero(~np.all(np.isfinite(arr.reshape(K, -1)), axis=1))
-        if bad.size:
-            k = int(bad[0])
-            raise IdentificationError(f"{name} of pose {k} is not a finite number", where=meas.where(k))
+        if np.isfinite(arr).all():
+            continue
+        k = int(np.flatnonzero(~np.all(np.isfinite(arr.reshape(K, -1)), axis=1))[0])
+        raise IdentificationError(f"{name} of pose {k} is not a finite number", where=meas.where(k))
+    return th, rd
 
 
 def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None, rtol=DEFAULT_RTOL,
-                  fit_alpha: float | None = None, accept_misfit: bool = False):
+                  fit_alpha: float | None = None, accept_misfit: bool = False, diagnostics: bool = True):
     """Identify zero offsets and MAEMM from one round of measurements by TSVD.
 
     The model is linearised at the prior: the nominal poses are
@@ -220,6 +225,21 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
         checked.
     accept_misfit : bool
         Keep a rejected fit as a calibration (status "accepted despite misfit").
+    diagnostics : bool
+        Default True: everything below.  False: the estimate only (the same
+        numbers, bit for bit) -- no covariance, residuals, honest std or fit
+        check (``covariance`` None, ``std_kind`` ``"lower bound"``, ``info``
+        only ``singular_values``, ``truncation``, ``filter_factors``,
+        ``rule``, ``kappa``, ``increment``, ``nominal_poses``,
+        ``right_singular_vectors``, ``maemm_prior`` and ``diagnostics``
+        False; status ends in "fit not checked").  For callers that use
+        the estimate alone, such as the Monte Carlo
+        (:mod:`zerocal_sym.identify.montecarlo`): its TSVD runs without a
+        noise model, where the fit check cannot reject anyway (zero noise:
+        nothing to test against), so ``success`` is the same as with
+        diagnostics; about 3x faster (many rounds at once:
+        :func:`identify_tsvd_many`).  With a noise model the fit check
+        could reject the fit, and without diagnostics it does not.
 
     Returns
     -------
@@ -265,18 +285,17 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     names = errors.resolve("offsets+measuring")
     offs, maemm = errors.zero_offsets, errors.measuring
     p = len(names)
-    _validate(meas, robot, p)
+    th, readings = _validate(meas, robot, p)
     prior = errors.zeros() if prior is None else np.asarray(prior, float)
-    if prior.shape != (len(errors),) or not np.all(np.isfinite(prior)):
+    if prior.shape != (len(errors),) or not np.isfinite(prior).all():
         raise ValueError(f"prior must be a finite vector of the {len(errors)} source errors")
-    th = np.asarray(meas.theta_cmd, float)
     P = kin.fk(robot, th + errors.take(prior, offs))
-    bad = np.flatnonzero(~np.all(np.isfinite(P), axis=1))
-    if bad.size:
-        k = int(bad[0])
+    if not np.isfinite(P).all():
+        k = int(np.flatnonzero(~np.all(np.isfinite(P), axis=1))[0])
         raise PoseError("commanded joint angles are not an assembly of the robot", where=meas.where(k))
-    G, lam = identification_matrix(robot, P, maemm_prior=errors.take(prior, maemm))
-    b = np.asarray(meas.readings, float)[1:] - np.diff(lam)
+    maemm_prior = errors.take(prior, maemm)
+    G, lam = identification_matrix(robot, P, maemm_prior=maemm_prior)
+    b = readings[1:] - np.diff(lam)
     s = np.linalg.svd(G, compute_uv=False)
     if s[-1] <= RANK_RTOL * s[0]:
         rank = int(np.sum(s > RANK_RTOL * s[0]))
@@ -290,7 +309,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
             f"{s[0] / s[-1]:.3g}); use poses that span the workspace (e.g. the {robot.workspace.scheme_name} "
             "scheme's two boundaries)", where=meas.source)
     C = None
-    if noise is not None:
+    if noise is not None and (diagnostics or (rule == "discrepancy" and t is None)):
         C = change_covariance(robot, th, noise, err0=prior)  # tridiagonal, as bands: O(K)
     noise_std = None if C is None else C.std()
     if rule == "discrepancy" and t is None and noise_std is None:
@@ -298,8 +317,9 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     sol = tsvd_solve(G, b, t=t, rule=rule, rtol=rtol, noise_std=noise_std)
     # G's columns: offsets as lengths (lever * dtheta), then the MAEMM (mm)
     T = np.diag(1.0 / robot.error_scale(names))
-    inc = T @ sol.x
-    est = errors.take(prior, names) + inc
+    inc, est, status, info = _estimate(errors, names, prior, sol, s, T, P, maemm_prior)
+    if not diagnostics:  # the estimate alone (the Monte Carlo): no covariance, residuals, honest std, fit check
+        return _lean(errors, names, est, status, info)
     lin_res = b - G @ sol.x
     A = T @ sol.operator()
     m = G.shape[0]
@@ -312,23 +332,10 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     full = errors.put(errors.zeros(), names, est)
     pred = np.diff(kin.distance(robot, th, full))
     residuals = np.asarray(meas.readings, float)[1:] - pred
-    status = f"ok: TSVD t = {sol.t} of {s.size} ({sol.rule})"
-    if sol.t < s.size:
-        status += "; truncated directions are not identified (biased estimate)"
     honest = _honest_uncertainty(robot, meas, names, errors.put(errors.zeros(), names, errors.take(prior, names)),
                                  noise, est, sol, cov)
-    info = {
-        "singular_values": sol.singular_values,
-        "truncation": sol.t,
-        "filter_factors": sol.filter_factors,
-        "rule": sol.rule,
-        "kappa": float(s[0] / s[-1]),
-        "linear_residuals": lin_res,
-        "increment": inc,
-        "nominal_poses": P,
-        "right_singular_vectors": sol.Vt,
-        "maemm_prior": errors.take(prior, maemm),
-    }
+    items = list(info.items())  # the keys in their documented order: linear_residuals after kappa
+    info = dict(items[:5] + [("linear_residuals", lin_res)] + items[5:])
     info.update({k: v for k, v in honest.items() if not k.startswith("_")})
     res = IdentificationResult(method="tsvd", params=names, estimate=est, covariance=honest["_covariance"],
                                success=True, status=status, residuals=residuals, info=info, errors=errors,
@@ -342,6 +349,156 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
                           evaluated_at=honest["_evaluated_at"])
     res.info["fit"]["chi2_at_estimate"] = honest["_chi2_at_estimate"]
     return res
+
+
+def _estimate(errors, names, prior, sol, s, T, P, maemm_prior):
+    """``(inc, est, status, info)`` of a TSVD solution (``T``: ``L dth`` to ``dth``; ``s``: G's singular values)."""
+    inc = T @ sol.x
+    est = errors.take(prior, names) + inc
+    status = f"ok: TSVD t = {sol.t} of {s.size} ({sol.rule})"
+    if sol.t < s.size:
+        status += "; truncated directions are not identified (biased estimate)"
+    info = {
+        "singular_values": sol.singular_values,
+        "truncation": sol.t,
+        "filter_factors": sol.filter_factors,
+        "rule": sol.rule,
+        "kappa": float(s[0] / s[-1]),
+        "increment": inc,
+        "nominal_poses": P,
+        "right_singular_vectors": sol.Vt,
+        "maemm_prior": maemm_prior,
+    }
+    return inc, est, status, info
+
+
+def _raise_if_interrupt(exc):
+    """Re-raise Ctrl-C that C code turned into an error (CasADi's ``RuntimeError("KeyboardInterrupt")``, an
+    error made of one): a batch must not swallow it (see ``zerocal_sym.cli._interrupt``)."""
+    e, seen = exc, set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt) or (isinstance(e, RuntimeError) and str(e).strip() == "KeyboardInterrupt"):
+            raise exc
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+
+
+def _lean(errors, names, est, status, info):
+    """The result without diagnostics (``identify_tsvd(..., diagnostics=False)``)."""
+    info["diagnostics"] = False
+    return IdentificationResult(method="tsvd", params=names, estimate=est, covariance=None, success=True,
+                                status=status + "; fit not checked (diagnostics off)", info=info,
+                                errors=errors, std_kind="lower bound")
+
+
+def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL) -> list:
+    """``identify_tsvd(robot, meas, prior, t=t, rule=rule, rtol=rtol, diagnostics=False)`` of many rounds at once.
+
+    The kinematics, identification matrices and SVDs of all rounds (with
+    the same number of poses) are evaluated in one batch; every batched
+    operation acts on each round alone, so the results are those of one call
+    per round bit for bit, at a fraction of the cost for short rounds (the
+    Monte Carlo's loops run in lockstep through this:
+    :func:`zerocal_sym.identify.loop.calibration_loops`).  A round the batch
+    cannot take (a check fails, an unreachable pose) is identified alone.
+
+    Parameters
+    ----------
+    rounds : sequence of Measurements
+    priors : sequence of ndarray (q,) or None, optional
+        One per round (default: all zero).
+    t, rule, rtol
+        As :func:`identify_tsvd` (no noise model: not the ``discrepancy`` rule).
+
+    Returns
+    -------
+    list
+        Per round its :class:`IdentificationResult`, or the exception
+        :func:`identify_tsvd` raised for it.
+    """
+    from zerocal_sym.identify.linear import identification_matrix
+    from zerocal_sym.model import kinematics as kin
+
+    rounds = list(rounds)
+    priors = [None] * len(rounds) if priors is None else list(priors)
+    if len(priors) != len(rounds):
+        raise ValueError(f"{len(rounds)} rounds but {len(priors)} priors")
+    out = [None] * len(rounds)
+
+    def alone(i):
+        try:
+            out[i] = identify_tsvd(robot, rounds[i], priors[i], t=t, rule=rule, rtol=rtol, diagnostics=False)
+        except Exception as exc:  # noqa: BLE001 - handed back as that round's outcome
+            _raise_if_interrupt(exc)
+            out[i] = exc
+
+    errors = robot.errors
+    if rule == "discrepancy" and t is None or robot.n < 2:
+        for i in range(len(rounds)):
+            alone(i)
+        return out
+    names = errors.resolve("offsets+measuring")
+    p = len(names)
+    i_off = [errors.index(n) for n in errors.zero_offsets]
+    i_meas = [errors.index(n) for n in errors.measuring]
+    T = np.diag(1.0 / robot.error_scale(names))
+    groups = {}  # K -> [(i, theta_cmd, readings, prior)]
+    for i, (meas, prior) in enumerate(zip(rounds, priors)):
+        try:
+            th, rd = _validate(meas, robot, p)
+            prior = errors.zeros() if prior is None else np.asarray(prior, float)
+            ok = prior.shape == (len(errors),) and np.isfinite(prior).all()
+        except Exception as exc:  # noqa: BLE001 - alone, it raises the same
+            _raise_if_interrupt(exc)
+            ok = False
+        if ok:
+            groups.setdefault(th.shape[0], []).append((i, th, rd, prior))
+        else:
+            alone(i)
+    for K, items in groups.items():
+        try:
+            P = kin.fk(robot, np.concatenate([th + prior[i_off] for _, th, _, prior in items]))
+            fin = np.isfinite(P).reshape(len(items), -1).all(axis=1)
+            for (i, *_), f in zip(items, fin):
+                if not f:
+                    alone(i)
+            items = [it for it, f in zip(items, fin) if f]
+            if not items:
+                continue
+            N = len(items)
+            P = P.reshape(-1, K, P.shape[1])[fin].reshape(N * K, -1)
+            mp = [prior[i_meas] for *_, prior in items]
+            G, lam = identification_matrix(robot, P, maemm_prior=np.repeat(mp, K, axis=0))
+            G = G[(np.arange(N)[:, None] * K + np.arange(K - 1)).ravel()].reshape(N, K - 1, p)
+            lam = lam.reshape(N, K)
+            B = np.array([rd for _, _, rd, _ in items])[:, 1:] - np.diff(lam, axis=1)
+            S = np.linalg.svd(G, compute_uv=False)
+            P3 = P.reshape(N, K, -1)
+            spread = np.linalg.svd(P3 - P3.mean(axis=1, keepdims=True), compute_uv=False)
+            good = ((S[:, -1] > RANK_RTOL * S[:, 0]) & (spread[:, 1] > COLLINEAR_RTOL * spread[:, 0])
+                    & np.isfinite(G).reshape(N, -1).all(axis=1) & np.isfinite(B).all(axis=1))
+            U, S2, Vt = np.linalg.svd(G[good], full_matrices=False)
+        except Exception as exc:  # noqa: BLE001 - e.g. an unreachable pose: each round alone says which
+            _raise_if_interrupt(exc)
+            for i, *_ in items:
+                alone(i)
+            continue
+        k = 0
+        for j, (i, th, rd, prior) in enumerate(items):
+            if not good[j]:
+                alone(i)
+                continue
+            try:
+                sol = _solve_svd(U[k], S2[k], Vt[k], B[j], K - 1, t, rule, rtol, None, 1.0)
+            except Exception as exc:  # noqa: BLE001 - alone, it raises the same
+                _raise_if_interrupt(exc)
+                alone(i)
+                k += 1
+                continue
+            k += 1
+            _, est, status, info = _estimate(errors, names, prior, sol, S[j], T, P3[j], mp[j])
+            out[i] = _lean(errors, names, est, status, info)
+    return out
 
 
 def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_noise) -> dict:
