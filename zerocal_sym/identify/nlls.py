@@ -110,7 +110,7 @@ def _initial(robot, meas, names, prior_q, warm_start):
         except ImportError:
             return x0, "prior (tsvd unavailable)"
         try:
-            ts = identify_tsvd(robot, meas, prior=prior_q)
+            ts = identify_tsvd(robot, meas, prior=prior_q, diagnostics=False)  # the estimate alone
         except Exception as exc:  # noqa: BLE001 - a failed warm start is not fatal
             return x0, f"prior (tsvd failed: {exc})"
         for k, n in enumerate(names):

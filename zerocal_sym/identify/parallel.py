@@ -192,6 +192,10 @@ def _stop_pool(pool, futs):
         if p.is_alive():
             p.terminate()
     pool.shutdown(wait=False, cancel_futures=True)
+    for p in list((getattr(pool, "_processes", None) or {}).values()):  # one started since the snapshot
+        if p not in procs:
+            procs.append(p)
+            p.terminate()
     deadline = time.monotonic() + 0.5
     for p in procs:
         p.join(max(0.0, deadline - time.monotonic()))
