@@ -82,10 +82,11 @@ def test_compiled_functions_equal_the_interpreted_bit_for_bit(robot, built, data
     for x, y in zip(a, b):
         np.testing.assert_array_equal(x, y)
     rng = np.random.default_rng(3)
-    for name in ("weights", "residuals", "jfun", "rfun", "nlp_f", "nlp_grad_f", "nlp_hess_l"):
+    for name in ("weights", "residuals", "jfun", "rfun", "nlp_f", "nlp_grad_f", "nlp_hess_l", "fit_terms"):
         f = interp[name]
         args = _inputs(f, rng)
-        args[1] = np.concatenate([par, np.abs(args[1].ravel()[par.size:]) + 1.0]) if name.startswith("nlp") else par
+        if name != "fit_terms":  # (r, J, l, b): random; the others take the parameter vector second
+            args[1] = np.concatenate([par, np.abs(args[1].ravel()[par.size:]) + 1.0]) if name.startswith("nlp") else par
         for x, y in zip(f.call(args), comp[name].call(args)):
             np.testing.assert_array_equal(x.full(), y.full(), err_msg=name)
 

@@ -413,3 +413,18 @@ def test_detection_rate_of_one_bad_reading(robot):
     print(rates)
     assert 0.10 < rates[6, 0.1] < 0.22 and 0.86 < rates[6, 0.5] < 0.95
     assert 0.58 < rates[12, 0.1] < 0.69 and rates[12, 0.5] > 0.99
+
+
+def test_banded_per_reading_terms_equal_the_dense_ones(case):
+    """identify_nlls's per-reading statistics come from the O(K p) banded terms (nlls_problem._fit_terms); the
+    fit check recomputed with the dense whitener (fit_check) gives the same numbers, a bad reading included."""
+    for th, bad in ((case.th_large, None), (case.th_large, (3, 0.05)), (case.th_small, None)):
+        m = case.meas(th, seed=5, bad=bad)
+        res = identify_nlls(case.robot, m, "paper", noise=PAPER, accept_misfit=True)
+        dense = fit_check(case.robot, m, res, diagnose=False)
+        fast = res.info["fit"]
+        assert fast["chi2"] == pytest.approx(dense["chi2"], rel=1e-12)
+        for key in ("standardised", "leverage", "estimated_error_mm"):
+            a = np.array([r[key] for r in fast["readings"]], float)
+            b = np.array([r[key] for r in dense["readings"]], float)
+            np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9, err_msg=key)

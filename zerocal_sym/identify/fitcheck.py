@@ -168,31 +168,43 @@ class _Linear:
 
     ``r`` (N,) whitened residuals, data rows first (n of them) then the prior
     rows; ``J`` (N, c) whitened Jacobian w.r.t. the fitted coordinates;
-    ``W`` (n, n) the whitener of the data rows; ``poses`` (n,) the pose index
-    k of each data row; ``raw`` (n,) residuals in mm; ``basis`` (p, c) maps
-    the fitted coordinates to the scaled parameters ``z`` (``p = z / scale``).
+    ``W`` (n, n) the whitener of the data rows, or None with ``band=(l, b)``,
+    the banded Cholesky factor it is the inverse of (``W`` is then built
+    only if asked for); ``poses`` (n,) the pose index k of each data row;
+    ``raw`` (n,) residuals in mm; ``basis`` (p, c) maps the fitted
+    coordinates to the scaled parameters ``z`` (``p = z / scale``).
+    ``svd``: the caller's thin SVD of ``J`` (its U may carry extra zero rows
+    below); ``terms``: the per-reading terms ``(aa, num, den, Q)`` computed
+    without ``W`` (``nlls_problem._fit_terms``; full column rank, no prior rows).
     """
 
-    def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None):
+    def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None,
+                 band=None, terms=None):
         self.r = np.asarray(r, float)
         self.J = np.atleast_2d(np.asarray(J, float))
-        self.W = np.asarray(W, float)
         self.poses = np.asarray(poses, int)
         self.raw = np.asarray(raw, float)
         self.basis = np.asarray(basis, float)
         self.scale = np.asarray(scale, float)
         self.names = tuple(names)
-        self.n = self.W.shape[0]
+        self.n = self.poses.size
         self.n_prior_rows = int(n_prior_rows)
         self.point = point
+        self._W, self._band, self._terms = (None if W is None else np.asarray(W, float)), band, terms
+        if W is None and band is None:
+            raise ValueError("_Linear needs W or band")
+        if self._W is not None:
+            w_ok = bool(np.isfinite(self._W).all())
+        else:
+            l, b = (np.ravel(np.asarray(x, float)) for x in band)
+            w_ok = bool(np.isfinite(l).all() and np.isfinite(b).all() and np.all(l != 0))
         #: False when the exact model cannot be evaluated there (a pose is not an assembly with these errors)
-        self.valid = bool(np.isfinite(self.r).all() and np.isfinite(self.J).all() and np.isfinite(self.W).all())
+        self.valid = bool(np.isfinite(self.r).all() and np.isfinite(self.J).all() and w_ok)
         if not self.valid:
             self.r = np.where(np.isfinite(self.r), self.r, 0.0)
             self.J = np.where(np.isfinite(self.J), self.J, 0.0)
-            self.W = np.where(np.isfinite(self.W), self.W, 0.0)
-            svd = None
-        # ``svd``: the caller's thin SVD of this J (its U may carry extra zero rows below), or None
+            self._W = np.where(np.isfinite(self.W), self.W, 0.0)
+            svd, self._terms = None, None
         if svd is None:
             U, s, Vt = np.linalg.svd(self.J, full_matrices=False)
         else:
@@ -202,6 +214,20 @@ class _Linear:
         self.rank = int(np.sum(s > tol)) if s.size else 0
         self.U, self.s, self.Vt = U[:, : self.rank], s[: self.rank], Vt[: self.rank]
         self.dof = self.n + self.n_prior_rows - self.rank
+        if self._terms is not None and (self.rank != self.J.shape[1] or self.n_prior_rows
+                                        or self.r.size != self.n):
+            self._terms = None  # the terms assume full column rank and no prior rows
+
+    @property
+    def W(self) -> np.ndarray:
+        """The whitener of the data rows (n, n), dense (built on first use from ``band``)."""
+        if self._W is None:
+            try:
+                with np.errstate(all="ignore"):
+                    self._W = band_whitener(*self._band)
+            except np.linalg.LinAlgError:  # a zero on the diagonal: no whitener (the fit is not valid)
+                self._W = np.full((self.n, self.n), np.nan)
+        return self._W
 
     def indicator(self, j) -> np.ndarray:
         """Whitened indicator ``a`` of data row j (N,)."""
@@ -213,20 +239,26 @@ class _Linear:
         """``(t, leverage, delta, dz)`` for every data row: the mean-shift statistic, leverage,
         estimated error of the reading (mm) and the change of ``z`` (n, p) when the reading is removed."""
         n = self.n
-        A = np.zeros((self.r.size, n))
-        A[:n] = self.W                             # column j: the whitened indicator a_j
-        aa = np.sum(A * A, axis=0)
-        UA = self.U.T @ A                          # (rank, n)
-        den = aa - np.sum(UA * UA, axis=0)         # a^T (I - H) a
-        num = A.T @ self.r - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
+        if self._terms is not None:  # O(n p), from the banded factor (the same quantities, no n x n matrix)
+            aa, num, den, Q = (np.asarray(x, float) for x in self._terms)
+            aa, num, den = aa.ravel(), num.ravel(), den.ravel()
+            Q = Q.reshape(self.J.shape[1], n)
+        else:
+            A = np.zeros((self.r.size, n))
+            A[:n] = self.W                             # column j: the whitened indicator a_j
+            aa = np.sum(A * A, axis=0)
+            UA = self.U.T @ A                          # (rank, n)
+            den = aa - np.sum(UA * UA, axis=0)         # a^T (I - H) a
+            num = A.T @ self.r - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
+            # F^+ J^T a_j: the move of the coordinates per unit error of reading j
+            Q = self.Vt.T @ (UA / self.s[:, None]) if self.rank else None
         with np.errstate(divide="ignore", invalid="ignore"):
             lev = np.where(aa > 0, 1.0 - den / aa, 1.0)
             ok = den > LEVERAGE_TOL * aa
             t = np.where(ok, num / np.sqrt(np.where(ok, den, 1.0)), np.nan)
             delta = np.where(ok, num / np.where(ok, den, 1.0), np.nan)
         # the fit with a free error on reading j moves the coordinates by F^+ J^T a_j delta_j
-        coords = (self.Vt.T @ (UA / self.s[:, None])) * delta[None, :] if self.rank else np.zeros((0, n))
-        dz = (self.basis @ coords).T if self.rank else np.full((n, self.basis.shape[0]), np.nan)
+        dz = (self.basis @ (Q * delta[None, :])).T if self.rank else np.full((n, self.basis.shape[0]), np.nan)
         dz[~ok] = np.nan
         return t, lev, delta, dz
 

@@ -382,10 +382,14 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     # the fit check: whitened exact-model residuals at the estimate against the noise model
     rows = np.flatnonzero(np.any(w != 0, axis=1))
     if robust is None:
+        terms = None
+        if not rows.size and rank == len(names) and "fit_terms" in fast:  # the per-reading terms, O(K p)
+            terms = [o.copy() for o in fast["fit_terms"](r, Jd, l, b)]
         lin = fitcheck._Linear(np.concatenate([r, rp[rows]]), np.vstack([Jd, J[K - 1:][rows]]),
-                               fitcheck.band_whitener(l, b), np.arange(1, K), s - pred, np.eye(len(names)),
-                               scale, names, len(rows),
-                               svd=None if rows.size else (UJ, sJ, Vt))  # no prior rows: J's SVD is Jd's
+                               None, np.arange(1, K), s - pred, np.eye(len(names)),
+                               scale, names, len(rows), band=(l, b),
+                               svd=None if rows.size else (UJ, sJ, Vt),  # no prior rows: J's SVD is Jd's
+                               terms=terms)
         at = "estimate"
     else:
         lin = _robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)

@@ -113,6 +113,45 @@ def _banded_cholesky(v, sm2):
     return ca.vertcat(l0, lr.T), br.T
 
 
+def _fit_terms(n: int, p: int):
+    """The fit check's per-reading terms without a dense whitener (:meth:`fitcheck._Linear.per_reading`).
+
+    Inputs: whitened residuals ``r`` (n,), whitened data Jacobian ``J``
+    (n, p) of full column rank, the banded Cholesky factor ``l`` (n,), ``b``
+    (n-1,) of the change covariance.  With ``a_j = L^-1 e_j`` the whitened
+    indicator of reading j, ``F = J^T J``, ``G = L^-T J`` (rows ``J^T a_j``):
+    ``aa_j = |a_j|^2`` (the diagonal of ``C^-1``, a backward recurrence),
+    ``num_j = a_j^T (r - J F^-1 J^T r)``, ``den_j = aa_j - G_j F^-1 G_j^T``,
+    ``Q = F^-1 G^T`` (p, n).  Every operation is O(n p): no n x n matrix.
+    """
+    import casadi as ca
+
+    r, J = ca.SX.sym("r", n), ca.SX.sym("J", n, p)
+    l, b = ca.SX.sym("l", n), ca.SX.sym("b", max(n - 1, 0))
+    F = ca.mtimes(J.T, J)
+    e = r - ca.mtimes(J, ca.solve(F, ca.mtimes(J.T, r)))
+
+    def back(v):  # L^-T v: back substitution with the upper-bidiagonal L^T, row by row from the last
+        rows = [None] * n
+        rows[n - 1] = v[n - 1, :] / l[n - 1]
+        for i in range(n - 2, -1, -1):
+            rows[i] = (v[i, :] - b[i] * rows[i + 1]) / l[i]
+        return ca.vertcat(*rows)
+
+    num = back(e)
+    G = back(J)
+    # |L^-1 e_j|^2 = (1 + c_{j+1}^2 S_{j+1}) / l_j^2 with c_k = -b_{k-1} / l_k, S_{n-1} = 1
+    S = [None] * n
+    S[n - 1] = ca.SX(1)
+    for j in range(n - 2, -1, -1):
+        S[j] = 1 + (b[j] / l[j + 1]) ** 2 * S[j + 1]
+    aa = ca.vertcat(*[S[j] / l[j] ** 2 for j in range(n)])
+    Q = ca.solve(F, G.T)
+    den = aa - ca.sum1(G.T * Q).T
+    return ca.Function("fit_terms", [r, J, l, b], [aa, num, den, Q], ["r", "J", "l", "b"],
+                       ["aa", "num", "den", "Q"])
+
+
 class NllsProblem:
     """The cached functions for (mechanism, K, parameter indices)."""
 
@@ -191,6 +230,8 @@ class NllsProblem:
         self.gauss_newton = unroll(True)
         self.gauss_newton_fixed = unroll(False)
 
+        fit_terms = _fit_terms(K - 1, p) if self.expanded else None
+
         c = X.sym("obj_scale")
         pn = ca.vertcat(par, L, B, c)
         f_obj = 0.5 * c * ca.dot(res, res)
@@ -204,6 +245,8 @@ class NllsProblem:
         funcs = {"gauss_newton": self.gauss_newton, "gauss_newton_fixed": self.gauss_newton_fixed,
                  "weights": self.weights, "residuals": self.residuals, "rfun": self.rfun, "jfun": self.jfun,
                  "nlp_f": nlp_f, "nlp_grad_f": nlp_grad_f, "nlp_hess_l": nlp_hess_l}
+        if fit_terms is not None:
+            funcs["fit_terms"] = fit_terms
         if self.expanded:
             funcs = {k: (f.expand() if k.startswith("nlp") else f) for k, f in funcs.items()}
         # Ipopt's interface builds a gradient of the objective at init: the compiled objective carries its adjoint
@@ -217,7 +260,8 @@ class NllsProblem:
         if self._version != self.tier.version:
             fs = self.tier.get()
             self._fast = {name: FastCall(fs[name])
-                          for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun")}
+                          for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun",
+                                       "fit_terms") if name in fs}
             self._solvers, self._batch = {}, {}
             self._version = self.tier.version
         return self.tier.get()
