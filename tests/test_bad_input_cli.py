@@ -156,7 +156,7 @@ ROBOT_CASES = {
     "not a number": (lambda t: t.replace("H = 632", 'H = "632"'), "H", r"key 'H' must be a number"),
     "metres": (lambda t: "\n".join(ln for ln in t.split("\n") if not ln.startswith("units")).replace(
         "L = 375", "L = 0.375").replace("l = 825", "l = 0.825"), "L", r"look like metres"),
-    "not TOML": (lambda t: t.replace("ex = 80", "ex == 80"), None, r"not valid TOML"),
+    "not TOML": (lambda t: t.replace("ex = 80", "ex == 80"), "ex", r"not valid TOML"),  # the line named
 }
 
 

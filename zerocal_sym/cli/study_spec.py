@@ -37,7 +37,6 @@ from __future__ import annotations
 import hashlib
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -263,19 +262,11 @@ def load_spec(path) -> Study:
     from zerocal_sym.cli._common import parse_named_values
     from zerocal_sym.model import kinematics as kin
 
+    from zerocal_sym.model.robot import read_toml
+
     path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise StudySpecError("study spec not found", where=str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise StudySpecError(f"cannot read the study spec: {exc}", where=str(path)) from None
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        m = re.search(r"line (\d+)", str(exc))
-        raise StudySpecError(f"not valid TOML: {exc}", where=f"{path}:{m.group(1)}" if m else str(path)) from None
-    where = _Where(path, text)
+    raw = read_toml(path, StudySpecError, "study spec")
+    where = _Where(path, path.read_text())
     base = path.parent
     for k in raw:
         if k not in SPEC_KEYS:

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from zerocal_sym.design.shapes import CentredBox
 from zerocal_sym.errors import ZerocalError
 
 #: grid points used to find the reachable set (per region; 3-D uses about as many)
@@ -220,7 +221,7 @@ def _triangulate(V):
 
 # --------------------------------------------------------------------------- the reachable set
 @dataclass(frozen=True)
-class ReachableRegion:
+class ReachableRegion(CentredBox):
     """The reachable, non-singular set of the robot (home's modes), clipped; see the module docstring.
 
     Attributes
@@ -251,14 +252,6 @@ class ReachableRegion:
     @property
     def hi(self):
         return np.array(self.hi_box, float)
-
-    @property
-    def center(self):
-        return (self.lo + self.hi) / 2
-
-    @property
-    def half(self):
-        return (self.hi - self.lo) / 2
 
     def in_component(self, P):
         """Bool per pose: the nearest grid node (of the component grown by one cell) is in the region's component."""

@@ -22,8 +22,22 @@ import numpy as np
 from zerocal_sym.design.limits import _FEAS_TOL, DesignError, _finite
 
 
+class CentredBox:
+    """``center`` and ``half`` of a region's bounding box (``lo``, ``hi``: shape (n,) each)."""
+
+    @property
+    def center(self):
+        """Centre of the bounding box, shape (n,)."""
+        return (self.lo + self.hi) / 2
+
+    @property
+    def half(self):
+        """Half sizes of the bounding box, shape (n,)."""
+        return (self.hi - self.lo) / 2
+
+
 @dataclass(frozen=True)
-class Region:
+class Region(CentredBox):
     """Axis-aligned design region of a rectangular workspace, mm: ``x in [xmin, xmax]``, ``y in [ymin, ymax]``."""
 
     xmin: float
@@ -51,16 +65,6 @@ class Region:
     def hi(self):
         """ndarray, shape (2,)"""
         return np.array([self.xmax, self.ymax])
-
-    @property
-    def center(self):
-        """Centre of the bounding box, shape (n,)."""
-        return (self.lo + self.hi) / 2
-
-    @property
-    def half(self):
-        """Half sizes of the bounding box, shape (n,)."""
-        return (self.hi - self.lo) / 2
 
     def grid(self, nx: int, ny: int):
         """Grid over the region, ndarray shape (nx*ny, 2), row-major in y."""
@@ -107,7 +111,7 @@ class Region:
 
 
 @dataclass(frozen=True)
-class CylinderRegion:
+class CylinderRegion(CentredBox):
     """Design region of a cylindrical workspace, mm: ``x^2 + y^2 <= rw^2``, ``z in [zmin, zmax]`` (on the z axis)."""
 
     rw: float
@@ -132,14 +136,6 @@ class CylinderRegion:
     def hi(self):
         """Bounding box, shape (3,)."""
         return np.array([self.rw, self.rw, self.zmax])
-
-    @property
-    def center(self):
-        return (self.lo + self.hi) / 2
-
-    @property
-    def half(self):
-        return (self.hi - self.lo) / 2
 
     def grid(self, nr: int = 4, na: int = 24, nz: int = 5):
         """Polar grid, shape (N, 3): on each of ``nz`` levels the axis and ``nr`` rings.

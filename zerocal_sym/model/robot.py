@@ -280,6 +280,25 @@ def _check_keys(keys: dict, where) -> None:
         _check_number(k, v, "mm" if k in ws_cls.keys or k == "singularity_margin" else unit(k), where)
 
 
+def read_toml(path, error, what: str) -> dict:
+    """The TOML file at ``path`` as a dict; ``error(message, where=...)`` naming the file (and line) otherwise.
+
+    ``what`` names the file in the messages ("robot file", "study spec").
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise error(f"{what} not found", where=str(path)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise error(f"cannot read the {what}: {exc}", where=str(path)) from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        m = re.search(r"line (\d+)", str(exc))
+        raise error(f"not valid TOML: {exc}", where=f"{path}:{m.group(1)}" if m else str(path)) from None
+
+
 def load_robot(path) -> Robot:
     """Read and validate a robot TOML file.
 
@@ -289,16 +308,8 @@ def load_robot(path) -> Robot:
         Naming the file, the line and the key (or workspace corner) at fault.
     """
     path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise RobotFileError("robot file not found", where=str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RobotFileError(f"cannot read robot file: {exc}", where=str(path)) from None
-    try:
-        keys = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise RobotFileError(f"not valid TOML: {exc}", where=str(path)) from None
+    keys = read_toml(path, RobotFileError, "robot file")
+    text = path.read_text()  # for the line numbers of the keys
 
     def where(key):
         line = _line_of(text, key) if key else None
