@@ -68,7 +68,7 @@ def cache_dir() -> Path:
     """Where compiled libraries are kept (``$ZEROCAL_CACHE``, else ``~/.cache/zerocal_sym``)."""
     d = os.environ.get("ZEROCAL_CACHE")
     if d:
-        return Path(d)
+        return Path(os.path.expanduser(d))
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return Path(base) / "zerocal_sym"
 
@@ -128,7 +128,8 @@ def build(src: str, path: Path, cc: str) -> None:
         c.write_text(src)
         out = Path(tmp) / path.name
         proc = subprocess.Popen([cc, *CFLAGS, str(c), "-o", str(out), "-lm"], stdout=subprocess.DEVNULL,
-                                stderr=subprocess.PIPE, text=True)
+                                stderr=subprocess.PIPE, text=True,
+                                start_new_session=hasattr(os, "killpg"))  # its own group: stopped as a whole
         with _RUNNING_LOCK:
             _RUNNING.add(proc)
         try:
@@ -152,7 +153,10 @@ def _stop_builds():
         procs = list(_RUNNING)
     for proc in procs:
         try:
-            proc.kill()
+            if hasattr(os, "killpg"):
+                os.killpg(proc.pid, 9)  # the compiler driver and the passes it started
+            else:
+                proc.kill()
             proc.wait(timeout=5)
         except Exception:  # noqa: BLE001 - exiting anyway
             pass
