@@ -118,6 +118,9 @@ def main(argv=None) -> int:
 
 
 def _interrupted(args) -> int:
+    from zerocal_sym.model.compiled import stop_builds
+
+    stop_builds()  # a compiler building in the background stops too (zerocal_sym.model.compiled)
     print(f"zerocal {args.command}: interrupted", file=sys.stderr)
     return 130
 

@@ -28,7 +28,6 @@ Functions with the same names, inputs and outputs:
 """
 from __future__ import annotations
 
-import atexit
 import contextlib
 import hashlib
 import os
@@ -87,6 +86,15 @@ def _log(key, event):
         del _LOG[:-200]
 
 
+def _fell_back(key, reason):
+    """Record a fallback; with ``ZEROCAL_COMPILE=always`` (compiling was asked for) also warn."""
+    _log(key, reason)
+    if mode() == "always":
+        import warnings
+
+        warnings.warn(f"ZEROCAL_COMPILE=always, but {key} runs interpreted: {reason}", RuntimeWarning, stacklevel=3)
+
+
 def status() -> list:
     """What the compiled tier did in this process: ``[(unix time, key, event), ...]``, newest last."""
     with _LOG_LOCK:
@@ -114,52 +122,69 @@ def library_path(functions: dict, cc: str, tag: str) -> Path:
     return cache_dir() / f"{safe}-{h.hexdigest()[:20]}.so"
 
 
+#: the build job: compile in its own folder (the compiler's temporary files there too), move the library into
+#: place, remove the folder -- it completes by itself if this process ends first
+_BUILD_SH = ('cd "$ZC_TMP" && "$@" -o out.so -lm 2> err.txt && mv -f out.so "$ZC_OUT" '
+             '&& cd / && rm -rf "$ZC_TMP"')
+
+
 def build(src: str, path: Path, cc: str) -> None:
-    """Compile ``src`` into ``path`` (atomically: a temporary file in the same folder, then ``os.replace``)."""
+    """Compile ``src`` into ``path``: a build job in a temporary folder beside it, then an atomic move.
+
+    The job (``sh``, its own process group) finishes by itself when this
+    process ends or is killed first, so the work lands in the cache;
+    :func:`stop_builds` stops it (Ctrl-C of a command).
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
-    for old in path.parent.glob(".build-*"):  # left by a process that ended mid-build
+    for old in path.parent.glob(".build-*"):  # left by a job that was stopped or failed
         try:
             if time.time() - old.stat().st_mtime > 3600:
                 shutil.rmtree(old, ignore_errors=True)
         except OSError:
             pass
-    with tempfile.TemporaryDirectory(dir=path.parent, prefix=".build-") as tmp:
-        c = Path(tmp) / "src.c"
-        c.write_text(src)
-        out = Path(tmp) / path.name
-        proc = subprocess.Popen([cc, *CFLAGS, str(c), "-o", str(out), "-lm"], stdout=subprocess.DEVNULL,
-                                stderr=subprocess.PIPE, text=True,
-                                start_new_session=hasattr(os, "killpg"))  # its own group: stopped as a whole
+    tmp = tempfile.mkdtemp(dir=path.parent, prefix=".build-")
+    try:
+        (Path(tmp) / "src.c").write_text(src)
+        env = dict(os.environ, ZC_TMP=tmp, ZC_OUT=str(path), TMPDIR=tmp)
+        proc = subprocess.Popen(["sh", "-c", _BUILD_SH, "zerocal-build", cc, *CFLAGS, "src.c"], env=env,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                start_new_session=True)  # its own group: Ctrl-C of the command does not reach it
         with _RUNNING_LOCK:
-            _RUNNING.add(proc)
+            _RUNNING[proc] = tmp
         try:
-            _, err = proc.communicate()
+            proc.wait()
         finally:
             with _RUNNING_LOCK:
-                _RUNNING.discard(proc)
-        if proc.returncode != 0:
-            raise RuntimeError(f"{cc} failed ({proc.returncode}): {err.strip()[-400:]}")
-        os.replace(out, path)
+                _RUNNING.pop(proc, None)
+        if proc.returncode != 0 or not path.exists():
+            try:
+                err = (Path(tmp) / "err.txt").read_text().strip()[-400:]
+            except OSError:
+                err = ""
+            raise RuntimeError(f"{cc} failed ({proc.returncode}): {err}")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
-_RUNNING: set = set()     # compiler processes of background builds
+_RUNNING: dict = {}     # build jobs of this process: Popen -> its folder
 _RUNNING_LOCK = threading.Lock()
 
 
-@atexit.register
-def _stop_builds():
-    """At exit, stop the compilers of unfinished background builds (a later build removes their folders)."""
+def stop_builds() -> None:
+    """Stop the build jobs of this process (the compiler and its passes; their folders go with them).
+
+    The CLI calls it when a command is interrupted; at a normal exit the jobs
+    finish by themselves and their libraries land in the cache.
+    """
     with _RUNNING_LOCK:
-        procs = list(_RUNNING)
-    for proc in procs:
+        jobs = list(_RUNNING.items())
+    for proc, tmp in jobs:
         try:
-            if hasattr(os, "killpg"):
-                os.killpg(proc.pid, 9)  # the compiler driver and the passes it started
-            else:
-                proc.kill()
+            os.killpg(proc.pid, 9)  # the shell, the compiler driver and the passes it started
             proc.wait(timeout=5)
-        except Exception:  # noqa: BLE001 - exiting anyway
+        except Exception:  # noqa: BLE001 - already gone
             pass
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 @contextlib.contextmanager
@@ -197,7 +222,7 @@ def compile_functions(functions: dict, tag: str, cached_only: bool = False) -> d
         raise ValueError(f"{tag}: the Functions to compile need distinct names")
     cc = compiler()
     if cc is None:
-        _log(tag, "no C compiler (set CC): interpreted")
+        _fell_back(tag, "no C compiler (set CC): interpreted")
         return None
     try:
         path = library_path(functions, cc, tag)
@@ -221,7 +246,7 @@ def compile_functions(functions: dict, tag: str, cached_only: bool = False) -> d
         _log(tag, f"loaded {path.name}")
         return out
     except Exception as exc:  # noqa: BLE001 - compilation is an optimisation: fall back, say why
-        _log(tag, f"failed, interpreted: {type(exc).__name__}: {exc}")
+        _fell_back(tag, f"failed, interpreted: {type(exc).__name__}: {exc}")
         return None
 
 
