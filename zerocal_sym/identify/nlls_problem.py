@@ -223,7 +223,8 @@ class NllsProblem:
             lk, bk = self.weights(zk, pp) if reweight else (lx, bx)
             rk, rpk, Jk, predk = self.residuals(zk, pp, lk, bk)
             ins, names = ([z0, pp], ["z0", "p"]) if reweight else ([z0, pp, lx, bx], ["z0", "p", "l0", "b0"])
-            fn = ca.Function("gauss_newton" if reweight else "gauss_newton_fixed", ins, [zk, dk, rk, rpk, Jk, predk, lk, bk],
+            fn = ca.Function("gauss_newton" if reweight else "gauss_newton_fixed", ins,
+                             [zk, dk, rk, rpk, Jk, predk, lk, bk],
                              names, ["z", "last_step", "r", "r_prior", "J", "pred", "l", "b"])
             return fn.expand() if self.expanded else fn
 

@@ -14,8 +14,9 @@ Functions with the same names, inputs and outputs:
   ``~/.cache/zerocal_sym``), named by a hash of the serialized Functions,
   the CasADi version, the compiler and its flags: a cached library is never
   stale, because any change of the Functions changes their serialization;
-  written atomically (a temporary name, then ``os.replace``), so concurrent
-  processes can share the cache;
+  built by a job in a temporary folder and moved into place (a rename), one
+  build per library across processes (a lock file), so concurrent processes
+  can share the cache;
 * ``ZEROCAL_COMPILE`` decides when: ``auto`` (default) -- the caller compiles
   the Functions it calls many times (a Monte Carlo, a batch, a loop of
   identifications; :class:`Tier`): a library already in the cache is loaded
@@ -193,7 +194,7 @@ def _build_lock(path: Path):
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         import fcntl
-    except ImportError:  # not POSIX: concurrent builds are only wasteful (os.replace keeps them safe)
+    except ImportError:  # not POSIX: concurrent builds are only wasteful (the final rename keeps them safe)
         yield
         return
     with open(path.with_suffix(".lock"), "a") as fh:
@@ -211,12 +212,14 @@ def load(functions: dict, path: Path) -> dict:
     return {k: ca.external(f.name(), str(path)) for k, f in functions.items()}
 
 
-def compile_functions(functions: dict, tag: str, cached_only: bool = False) -> dict | None:
+def compile_functions(functions: dict, tag: str, cached_only: bool = False, memo: dict | None = None) -> dict | None:
     """The compiled twins of ``functions`` (name -> casadi.Function), or None.
 
     Builds the library unless it is in the cache (``cached_only``: only a
     cached library, never a build).  None when there is no compiler, the
-    build or the load failed (recorded in :func:`status`).
+    build or the load failed (recorded in :func:`status`).  ``memo``: a dict
+    the caller keeps for these Functions, so that their library path (a
+    serialization of every Function) is computed once per compiler.
     """
     if len({f.name() for f in functions.values()}) != len(functions):
         raise ValueError(f"{tag}: the Functions to compile need distinct names")
@@ -225,7 +228,11 @@ def compile_functions(functions: dict, tag: str, cached_only: bool = False) -> d
         _fell_back(tag, "no C compiler (set CC): interpreted")
         return None
     try:
-        path = library_path(functions, cc, tag)
+        path = memo.get(cc) if memo is not None else None
+        if path is None:
+            path = library_path(functions, cc, tag)
+            if memo is not None:
+                memo[cc] = path
         if not path.exists() and cached_only:
             return None
         for attempt in (0, 1):
@@ -283,8 +290,13 @@ class Tier:
         self._started = False
         self._lock = threading.Lock()
         self._thread = None
+        self._memo = {}       # the library path per compiler (compile_functions)
         if mode() == "always":
-            self._swap(compile_functions(self._interp, tag))
+            self._started = True  # tried once; hot() does not build again
+            self._swap(self._compile())
+
+    def _compile(self, cached_only: bool = False):
+        return compile_functions(self._interp, self.tag, cached_only, self._memo)
 
     def get(self) -> dict:
         return self._current
@@ -308,12 +320,12 @@ class Tier:
         with self._lock:
             start, self._started = not self._started, True
         if start:
-            if self._swap(compile_functions(self._interp, self.tag, cached_only=True)) is not None:
+            if self._swap(self._compile(cached_only=True)) is not None:
                 return
             if m == "always" or wait:
-                self._swap(compile_functions(self._interp, self.tag))
+                self._swap(self._compile())
                 return
-            self._thread = threading.Thread(target=lambda: self._swap(compile_functions(self._interp, self.tag)),
+            self._thread = threading.Thread(target=lambda: self._swap(self._compile()),
                                             name=f"compile {self.tag}", daemon=True)
             self._thread.start()
         if wait and self._thread is not None:
