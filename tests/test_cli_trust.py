@@ -56,7 +56,7 @@ def test_bad_reading_named(capsys, tmp_path):
     rc, o, err = zc(capsys, "identify", data, "--noise", "scale-only", "--out", out)
     assert rc == 1 and not out.exists(), (o, err)
     assert "rejected" in err and "pose 5" in err, err
-    assert "verdict: rejected" in o
+    assert "verdict: rejected" in o and "rejected: rejected" not in o
     # --accept-misfit alone: the 0.9 mm reading drags the least-squares offsets to ~ -30 deg, which plausibility
     # refuses (exit 1, no file)
     rc, o, err = zc(capsys, "identify", data, "--noise", "scale-only", "--accept-misfit", "--out", out)

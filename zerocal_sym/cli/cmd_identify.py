@@ -280,7 +280,8 @@ def run(args):
         if diagnosis(res):
             print(diagnosis(res), file=sys.stderr)
         if not args.json:
-            print(f"verdict: rejected: {res.status}; next: see the diagnosis above, fix the data or the robot file "
+            status = res.status.removeprefix("rejected: ")  # the status of a rejected fit starts so already
+            print(f"verdict: rejected: {status}; next: see the diagnosis above, fix the data or the robot file "
                   "and identify again")
         return 1
     from zerocal_sym.identify.fitcheck import plausibility
