@@ -174,8 +174,9 @@ class _Linear:
     ``raw`` (n,) residuals in mm; ``basis`` (p, c) maps the fitted
     coordinates to the scaled parameters ``z`` (``p = z / scale``).
     ``svd``: the caller's thin SVD of ``J`` (its U may carry extra zero rows
-    below); ``terms``: the per-reading terms ``(aa, num, den, Q)`` computed
-    without ``W`` (``nlls_problem._fit_terms``; full column rank, no prior rows).
+    below); ``terms``: the per-reading statistics ``(t, leverage, delta,
+    move)`` computed without ``W`` (``nlls_problem._fit_terms``; full column
+    rank, no prior rows).
     """
 
     def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None,
@@ -211,7 +212,7 @@ class _Linear:
             U, s, Vt = svd
             U = U[: self.J.shape[0]]
         tol = RANK_RTOL * (s[0] if s.size else 0.0)
-        self.rank = int(np.sum(s > tol)) if s.size else 0
+        self.rank = int(np.count_nonzero(s > tol)) if s.size else 0
         self.U, self.s, self.Vt = U[:, : self.rank], s[: self.rank], Vt[: self.rank]
         self.dof = self.n + self.n_prior_rows - self.rank
         if self._terms is not None and (self.rank != self.J.shape[1] or self.n_prior_rows
@@ -235,23 +236,24 @@ class _Linear:
         a[: self.n] = self.W[:, j]
         return a
 
-    def per_reading(self):
+    def per_reading(self, moves: bool = True):
         """``(t, leverage, delta, dz)`` for every data row: the mean-shift statistic, leverage,
-        estimated error of the reading (mm) and the change of ``z`` (n, p) when the reading is removed."""
+        estimated error of the reading (mm) and the change of ``z`` (n, p) when the reading is removed
+        (None with ``moves=False``)."""
         n = self.n
         if self._terms is not None:  # O(n p), from the banded factor (the same quantities, no n x n matrix)
-            aa, num, den, Q = (np.asarray(x, float) for x in self._terms)
-            aa, num, den = aa.ravel(), num.ravel(), den.ravel()
-            Q = Q.reshape(self.J.shape[1], n)
-        else:
-            A = np.zeros((self.r.size, n))
-            A[:n] = self.W                             # column j: the whitened indicator a_j
-            aa = np.sum(A * A, axis=0)
-            UA = self.U.T @ A                          # (rank, n)
-            den = aa - np.sum(UA * UA, axis=0)         # a^T (I - H) a
-            num = A.T @ self.r - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
-            # F^+ J^T a_j: the move of the coordinates per unit error of reading j
-            Q = self.Vt.T @ (UA / self.s[:, None]) if self.rank else None
+            t, lev, delta, move = self._terms
+            t, lev, delta = np.ravel(t), np.ravel(lev), np.ravel(delta)
+            dz = (self.basis @ np.reshape(move, (self.J.shape[1], n), order="F")).T if moves else None
+            return t, lev, delta, dz
+        A = np.zeros((self.r.size, n))
+        A[:n] = self.W                             # column j: the whitened indicator a_j
+        aa = np.sum(A * A, axis=0)
+        UA = self.U.T @ A                          # (rank, n)
+        den = aa - np.sum(UA * UA, axis=0)         # a^T (I - H) a
+        num = A.T @ self.r - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
+        # F^+ J^T a_j: the move of the coordinates per unit error of reading j
+        Q = self.Vt.T @ (UA / self.s[:, None]) if self.rank else None
         with np.errstate(divide="ignore", invalid="ignore"):
             lev = np.where(aa > 0, 1.0 - den / aa, 1.0)
             ok = den > LEVERAGE_TOL * aa
@@ -286,7 +288,7 @@ def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
     chi2 = float(lin.r @ lin.r) if lin.valid else float("inf")
     dof = int(lin.dof)
     zero = noise.is_zero
-    t, lev, delta, _ = lin.per_reading()
+    t, lev, delta, _ = lin.per_reading(moves=False)
     if not lin.valid:
         t[:], delta[:] = np.nan, np.nan
     fit = {"model": "exact", "alpha": float(alpha), "chi2": chi2, "dof": dof, "p_value": None,

@@ -227,7 +227,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                                   f"{robot.name!r} has {robot.m} joints", where=getattr(meas, "source", None))
     s = np.asarray(meas.readings, float)[1:]
     prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
-    scale = fisher.parameter_scale(robot, names)
+    scale = robot.error_scale(names)  # fisher.parameter_scale
     if prior_cov is not None:
         if prior_std is not None:
             raise ValueError("give prior_std or prior_cov, not both")
@@ -250,19 +250,21 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         if np.any(std <= 0):
             raise ValueError("prior_std must be positive (inf for no prior)")
         w = np.diag(1.0 / std)
-    mu = errors.take(prior_q, names)
-    lbx, ubx = _bounds(bounds, list(names), scale)
-    x0, start = _initial(robot, meas, names, prior_q, warm_start)
-    z0 = np.clip(x0 * scale, lbx, ubx)
-
     prob = get_problem(robot, K, names)
     prob.touch()
+    mu = prior_q[list(prob.idx)]  # errors.take(prior_q, names)
+    has_prior = bool(w.any())
+    lbx, ubx = _bounds(bounds, list(names), scale)
+    x0, start = (mu.copy(), "prior") if warm_start is None else _initial(robot, meas, names, prior_q, warm_start)
+    z0 = x0 * scale if bounds is None else np.clip(x0 * scale, lbx, ubx)
+
     solver = prob.solver_for(max_iter)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
     fast = prob.fast
     z_gn, step, r, rp, J, pred, l, b = prob.run_gauss_newton(z0, par, bool(reweight), GN_STEP_TOL)
     step = float(step[0])
-    gn_ok = bool(np.all(np.isfinite(z_gn)) and step < GN_STEP_TOL and np.all(z_gn >= lbx) and np.all(z_gn <= ubx))
+    gn_ok = bool(np.isfinite(z_gn).all() and step < GN_STEP_TOL
+                 and (bounds is None or (np.all(z_gn >= lbx) and np.all(z_gn <= ubx))))
     if gn_ok:  # Ipopt confirms the Gauss-Newton point (weights at that point)
         z, passes = z_gn, 1
     else:      # Ipopt from the start; with reweight once more with the weights at its solution
@@ -273,16 +275,16 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         if k:
             l, b = (np.array(o) for o in fast["weights"](z, par))
         Jz = J[: K - 1] if (gn_ok and not k) else fast["jfun"](z, par, l, b)[0]
-        c = 1.0 / max(1e-300, float(np.sum(Jz * Jz)))  # GN Hessian of norm ~1 (Frobenius: no SVD)
+        c = 1.0 / max(1e-300, float(np.vdot(Jz, Jz)))  # GN Hessian of norm ~1 (Frobenius: no SVD)
         zn = solver(z, np.concatenate([par, l, b, [c]]), lbx, ubx)[0].copy()
         stats = solver.stats()
         total_iter += int(stats.get("iter_count", 0))
-        moved = not np.array_equal(zn, z)
+        moved = bool((zn != z).any())
         z = zn
         if str(stats.get("return_status")) not in CONVERGED_STATUSES:
             break
     ret = str(stats.get("return_status", "unknown"))
-    converged = ret in CONVERGED_STATUSES and bool(np.all(np.isfinite(z)))
+    converged = ret in CONVERGED_STATUSES and bool(np.isfinite(z).all())
     p_hat = z / scale
     if not gn_ok or moved:  # residuals and Jacobian at the final point (else Gauss-Newton's are current)
         l, b = (np.array(o) for o in fast["weights"](z if reweight else z0, par))
@@ -314,9 +316,9 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     # F = J^T J (data + prior information, scaled units) from one SVD of J: F = V diag(sJ^2) V^T
     UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False)
     sF = sJ**2
-    sv = (np.linalg.svd(Jd, compute_uv=False) if np.any(w) else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
+    sv = (np.linalg.svd(Jd, compute_uv=False) if has_prior else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
     tol = RANK_RTOL * (sF[0] if sF.size else 0.0)
-    rank = int(np.sum(sF > tol))
+    rank = int(np.count_nonzero(sF > tol))
     null = Vt[rank:]
     if noise.is_zero:
         dof = (K - 1) - rank
@@ -325,18 +327,19 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         s2 = 1.0
     Finv = (Vt[:rank].T / sF[:rank]) @ Vt[:rank]
     cov = s2 * Finv / np.outer(scale, scale)
-    nonid = []
-    for v in null:
-        v = v / scale  # direction in physical units
-        v = v / np.max(np.abs(v))
-        nonid.append({n: float(c) for n, c in zip(names, v) if abs(c) > 1e-6})
-    for k in range(len(names)):  # non-identifiable parameters get infinite variance
-        if null.size and np.max(np.abs(null[:, k])) > 1e-6:
-            cov[k, :] = np.nan
-            cov[:, k] = np.nan
-            cov[k, k] = np.inf
-    offsets_ok = all(not (null.size and np.max(np.abs(null[:, names.index(n)])) > 1e-6)
-                     for n in errors.zero_offsets if n in names)
+    nonid, offsets_ok = [], True
+    if null.size:  # rank deficient
+        for v in null:
+            v = v / scale  # direction in physical units
+            v = v / np.max(np.abs(v))
+            nonid.append({n: float(c) for n, c in zip(names, v) if abs(c) > 1e-6})
+        for k in range(len(names)):  # non-identifiable parameters get infinite variance
+            if np.max(np.abs(null[:, k])) > 1e-6:
+                cov[k, :] = np.nan
+                cov[:, k] = np.nan
+                cov[k, k] = np.inf
+        offsets_ok = all(not np.max(np.abs(null[:, names.index(n)])) > 1e-6
+                         for n in errors.zero_offsets if n in names)
     success = converged and offsets_ok
     if not converged:
         status = f"Ipopt did not converge: {ret}"
@@ -373,19 +376,20 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "prior": prior_q.tolist(),
         "loss": loss,
     }
-    if np.any(w):
+    if has_prior:
         info["prior_whitener"] = w.tolist()
     res = IdentificationResult(method="nlls", params=names, estimate=p_hat,
                                covariance=cov, success=bool(success), status=status,
                                residuals=np.asarray(s - pred), info=info, errors=errors,
                                std_kind="from residuals" if noise.is_zero else "total")
     # the fit check: whitened exact-model residuals at the estimate against the noise model
-    rows = np.flatnonzero(np.any(w != 0, axis=1))
+    rows = np.flatnonzero(np.any(w != 0, axis=1)) if has_prior else np.zeros(0, int)
     if robust is None:
         terms = None
         if not rows.size and rank == len(names) and "fit_terms" in fast:  # the per-reading terms, O(K p)
             terms = [o.copy() for o in fast["fit_terms"](r, Jd, l, b)]
-        lin = fitcheck._Linear(np.concatenate([r, rp[rows]]), np.vstack([Jd, J[K - 1:][rows]]),
+        lin = fitcheck._Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
+                               np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
                                None, np.arange(1, K), s - pred, np.eye(len(names)),
                                scale, names, len(rows), band=(l, b),
                                svd=None if rows.size else (UJ, sJ, Vt),  # no prior rows: J's SVD is Jd's
@@ -397,9 +401,10 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
               f"{', '.join(map(str, robust['excluded_readings']))})" if robust["excluded_readings"] else "estimate")
         info["robust"] = {k: v for k, v in robust.items() if not k.startswith("_")}
     tol_b = 1e-7 * (1.0 + np.abs(z))
-    active = [n for n, zz, lo, hi, tb in zip(names, z, lbx, ubx, tol_b) if zz <= lo + tb or zz >= hi - tb]
+    active = [] if bounds is None else [n for n, zz, lo, hi, tb in zip(names, z, lbx, ubx, tol_b)
+                                        if zz <= lo + tb or zz >= hi - tb]
     fitcheck.check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
-                          prior_whitener=w if np.any(w) else None, evaluated_at=at, active_bounds=active)
+                          prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     info["time_s"] = time.perf_counter() - t0
     return res
 

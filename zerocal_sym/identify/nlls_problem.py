@@ -41,6 +41,7 @@ import threading
 
 import numpy as np
 
+from zerocal_sym.identify.fitcheck import LEVERAGE_TOL
 from zerocal_sym.model.compiled import Tier
 from zerocal_sym.model.fastcall import FastCall
 
@@ -123,6 +124,13 @@ def _fit_terms(n: int, p: int):
     ``aa_j = |a_j|^2`` (the diagonal of ``C^-1``, a backward recurrence),
     ``num_j = a_j^T (r - J F^-1 J^T r)``, ``den_j = aa_j - G_j F^-1 G_j^T``,
     ``Q = F^-1 G^T`` (p, n).  Every operation is O(n p): no n x n matrix.
+
+    Outputs (what the fit check reads): the mean-shift statistic
+    ``t_j = num_j / sqrt(den_j)``, the leverage ``1 - den_j / aa_j``, the
+    estimated error of the reading ``delta_j = num_j / den_j`` (mm) and the
+    move of the fitted coordinates when it is removed, ``Q_j delta_j``
+    (p, n); NaN (except the leverage) for a reading that cannot be tested
+    (``den_j <= LEVERAGE_TOL aa_j``).
     """
     import casadi as ca
 
@@ -148,8 +156,26 @@ def _fit_terms(n: int, p: int):
     aa = ca.vertcat(*[S[j] / l[j] ** 2 for j in range(n)])
     Q = ca.solve(F, G.T)
     den = aa - ca.sum1(G.T * Q).T
-    return ca.Function("fit_terms", [r, J, l, b], [aa, num, den, Q], ["r", "J", "l", "b"],
-                       ["aa", "num", "den", "Q"])
+    # the statistics themselves (fitcheck._Linear.per_reading): a reading is testable when its mean-shift
+    # information is not negligible against its own (leverage < 1); NaN where it is not
+    ok = den > LEVERAGE_TOL * aa
+    nan = ca.SX(np.nan)
+    lev = ca.if_else(aa > 0, 1 - den / aa, 1)
+    t = ca.if_else(ok, num / ca.sqrt(ca.if_else(ok, den, 1)), nan)
+    delta = ca.if_else(ok, num / ca.if_else(ok, den, 1), nan)
+    move = ca.if_else(ca.repmat(ok.T, p, 1), Q * ca.repmat(delta.T, p, 1), nan)
+    return ca.Function("fit_terms", [r, J, l, b], [t, lev, delta, move], ["r", "J", "l", "b"],
+                       ["t", "leverage", "delta", "move"])
+
+
+def _cse(f):
+    """``f`` (an SX Function) with its common subexpressions merged (``casadi.cse``): the same operations on
+    the same numbers, so the same bits, in fewer instructions (the weights and the residuals of a
+    Gauss-Newton iteration share the kinematics)."""
+    import casadi as ca
+
+    sx = f.sx_in()
+    return ca.Function(f.name(), sx, ca.cse(f.call(sx)), f.name_in(), f.name_out())
 
 
 class NllsProblem:
@@ -249,7 +275,7 @@ class NllsProblem:
         if fit_terms is not None:
             funcs["fit_terms"] = fit_terms
         if self.expanded:
-            funcs = {k: (f.expand() if k.startswith("nlp") else f) for k, f in funcs.items()}
+            funcs = {k: _cse(f.expand() if k.startswith("nlp") else f) for k, f in funcs.items()}
         # Ipopt's interface builds a gradient of the objective at init: the compiled objective carries its adjoint
         funcs["adj1_nlp_f"] = funcs["nlp_f"].reverse(1)
         self.tier = Tier(funcs, f"nlls-{mechanism.name}-K{K}-" + "_".join(map(str, idx)))
@@ -328,11 +354,11 @@ class NllsProblem:
         z = np.asarray(z0, float)
         fixed = () if reweight else tuple(np.array(o) for o in self.fast["weights"](z, par))
         for _ in range(GN_BLOCKS):
-            out = [np.array(o) for o in fast(z, par, *fixed)]
+            out = fast(z, par, *fixed)  # views of the call's buffers: z is copied in by the next call
             z = out[0]
-            if not np.all(np.isfinite(z)) or float(out[1][0]) < tol:
+            if not np.isfinite(z).all() or out[1][0] < tol:
                 break
-        return out
+        return [np.array(o) for o in out]
 
     def batch(self, N: int) -> FastCall:
         """``gauss_newton`` mapped over N data sets (columns of z0 and of the parameter vector), zero-copy."""
