@@ -9,7 +9,8 @@ import pytest
 
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.batch import identify_batch
-from zerocal_sym.identify.fitcheck import (chi2_cdf, chi2_sf, deletion_diagnostics, fit_check, plausibility)
+from zerocal_sym.identify.chi2 import chi2_cdf, chi2_sf
+from zerocal_sym.identify.fitcheck import deletion_diagnostics, fit_check, plausibility
 from zerocal_sym.identify.loop import calibration_loop
 from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.identify.result import IdentificationResult

@@ -49,7 +49,7 @@ class BatchResult:
         Degrees of freedom of ``chi2`` (K - 1 - p).
     p_value : ndarray, shape (N,)
         The fit check's p-value ``P(chi2_dof >= chi2)``
-        (:func:`zerocal_sym.identify.fitcheck.chi2_sf`; NaN where not
+        (:func:`zerocal_sym.identify.chi2.chi2_sf`; NaN where not
         available).  The batch does not reject: ``success`` means converged;
         compare ``p_value`` with a level (the single path's default 0.001).
     """
@@ -160,7 +160,7 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
             std[k] = [res.std(nm) for nm in names]
             chi2[k] = res.info["chi2"]
             success[k] = True
-    from zerocal_sym.identify.fitcheck import chi2_sf
+    from zerocal_sym.identify.chi2 import chi2_sf
 
     dof = K - 1 - p
     pv = np.full(N, np.nan)

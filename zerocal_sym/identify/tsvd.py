@@ -9,167 +9,29 @@ mechanism (:mod:`zerocal_sym.identify.linear`):
 
 solved by the truncated SVD ``dp = sum_{i<=t} (u_i^T ds / sigma_i) v_i``.
 
-Truncation rules (:func:`tsvd_solve`)
--------------------------------------
-``threshold`` (**the default**)
-    keep ``sigma_i > rtol * sigma_1`` (default ``rtol = 1e-6``).  For the
-    paper's 4-parameter model this keeps all four singular values (``sigma_4 /
-    sigma_1 ~ 2.1e-3`` for the 6-pose scheme): the weakest direction (the
-    common mode of the offsets mixed with ``rMx``) carries the offsets, and
-    truncating it loses them (~0.4 deg even without noise, see
-    ``docs/reproduction.md``).  In the paper the "truncation" is the reduction
-    from the 12-parameter model (Eq. 24-27) to the 4-parameter one (Eq. 28);
-    Eq. (29) is then solved at full rank.  It is the default because it is the
-    only rule that reproduces the paper's accuracy and recovers the offsets
-    exactly without noise.
-``gcv``
-    generalised cross-validation, ``t = argmin ||r_t||^2 / (m - t)^2``
-    (``t < m``).  With ``m - p = 1`` degree of freedom (6 poses) it is fragile.
-``discrepancy``
-    Morozov's discrepancy principle: the smallest ``t`` with
-    ``||r_t|| <= tau * delta``, ``delta^2 = sum(noise_std^2)`` the expected
-    squared norm of the noise (``tau = 1``).  Needs the noise level, e.g. from
-    a :class:`~zerocal_sym.model.noise.NoiseModel` (:func:`identify_tsvd`
-    derives it from the measurement covariance).
-
-An explicit ``t`` overrides the rule.  The filter factors of TSVD are 1 for the
-kept singular values and 0 for the others.
+The truncated SVD itself and its truncation rules (``threshold``, the
+default; ``gcv``; ``discrepancy``) are in
+:mod:`~zerocal_sym.identify.truncated_svd` (:func:`tsvd_solve`); the
+covariance with what TSVD leaves out (the linearisation bias, the truncated
+directions' bias bound) in :mod:`~zerocal_sym.identify.tsvd_uncertainty`.
+Here: :func:`identify_tsvd`, and :func:`identify_tsvd_many` (many rounds at
+once, the estimate only).
 """
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from zerocal_sym.errors import IdentificationError, PoseError
 from zerocal_sym.identify.result import IdentificationResult
+# RULES and TSVDSolution: kept importable from here
+from zerocal_sym.identify.truncated_svd import (DEFAULT_RTOL, DEFAULT_RULE, RULES, TSVDSolution,  # noqa: F401
+                                                _solve_svd, tsvd_solve)
+from zerocal_sym.identify.tsvd_uncertainty import _honest_uncertainty
 
-RULES = ("threshold", "gcv", "discrepancy")
-DEFAULT_RULE = "threshold"
-DEFAULT_RTOL = 1e-6
 #: G with sigma_min / sigma_max below this is treated as rank-deficient (collinear poses).
 RANK_RTOL = 1e-9
 #: poses whose second principal extent is below this fraction of the first are "on one line".
 COLLINEAR_RTOL = 1e-6
-
-
-@dataclass
-class TSVDSolution:
-    """A truncated-SVD solution of ``G x = b``.
-
-    Attributes
-    ----------
-    x : ndarray, shape (p,)
-    t : int
-        Truncation level (number of singular values kept).
-    singular_values : ndarray, shape (min(m, p),)
-        All singular values of G, descending.
-    filter_factors : ndarray, shape (min(m, p),)
-        1 for kept, 0 for discarded singular values.
-    rule : str
-        ``"threshold"``, ``"gcv"``, ``"discrepancy"`` or ``"fixed"`` (t given).
-    U : ndarray, shape (m, r)
-    Vt : ndarray, shape (r, p)
-    residual_norms : ndarray, shape (r + 1,)
-        ``||G x_t - b||`` for ``t = 0 .. r``.
-    criterion : ndarray, shape (r + 1,) or None
-        GCV function (``gcv``) for each ``t``; None otherwise.
-    """
-
-    x: np.ndarray
-    t: int
-    singular_values: np.ndarray
-    filter_factors: np.ndarray
-    rule: str
-    U: np.ndarray = field(repr=False, default=None)
-    Vt: np.ndarray = field(repr=False, default=None)
-    residual_norms: np.ndarray = field(repr=False, default=None)
-    criterion: np.ndarray | None = field(repr=False, default=None)
-
-    @property
-    def condition_number(self) -> float:
-        s = self.singular_values
-        return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
-
-    def operator(self) -> np.ndarray:
-        """The linear map ``b -> x`` of this truncation, shape (p, m)."""
-        t = self.t
-        return (self.Vt[:t].T / self.singular_values[:t]) @ self.U[:, :t].T
-
-
-def tsvd_solve(G, b, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL, noise_std=None, tau=1.0) -> TSVDSolution:
-    """Truncated-SVD solution of ``G x = b``.
-
-    Parameters
-    ----------
-    G : ndarray, shape (m, p)
-    b : ndarray, shape (m,)
-    t : int, optional
-        Truncation level, ``1 <= t <= min(m, p)``; overrides ``rule``.
-    rule : {"threshold", "gcv", "discrepancy"}
-        Automatic choice of ``t`` (module docstring); default ``threshold``.
-    rtol : float
-        Relative singular-value threshold of the ``threshold`` rule.
-    noise_std : float or ndarray, shape (m,), optional
-        Noise std of each element of ``b`` (``discrepancy`` rule; required there).
-    tau : float
-        Safety factor of the discrepancy principle.
-
-    Returns
-    -------
-    TSVDSolution
-    """
-    G = np.asarray(G, float)
-    b = np.asarray(b, float)
-    if G.ndim != 2 or b.shape != (G.shape[0],):
-        raise ValueError(f"G must be (m, p) and b (m,), got {G.shape} and {b.shape}")
-    if not (np.isfinite(G).all() and np.isfinite(b).all()):
-        raise IdentificationError("G or b contains NaN or inf")
-    U, s, Vt = np.linalg.svd(G, full_matrices=False)
-    return _solve_svd(U, s, Vt, b, G.shape[0], t, rule, rtol, noise_std, tau)
-
-
-def _solve_svd(U, s, Vt, b, m, t, rule, rtol, noise_std, tau) -> TSVDSolution:
-    """:func:`tsvd_solve` from the thin SVD ``U, s, Vt`` of the checked G (m rows)."""
-    r = s.size
-    beta = U.T @ b
-    # ||r_t||^2 = ||b||^2 - sum_{i<=t} beta_i^2 (exact for the thin SVD plus the orthogonal part)
-    tail = np.concatenate([np.cumsum((beta**2)[::-1])[::-1], [0.0]])
-    perp = max(float(b @ b) - float(beta @ beta), 0.0)
-    res2 = tail + perp
-    criterion = None
-    positive = int(np.count_nonzero(s > 0))
-    if t is not None:
-        t = int(t)
-        if not 1 <= t <= r:
-            raise ValueError(f"truncation t must be in 1..{r}, got {t}")
-        used = "fixed"
-    elif rule == "threshold":
-        t = int(np.count_nonzero(s > rtol * s[0])) if s[0] > 0 else 0
-        used = rule
-    elif rule == "gcv":
-        ts = np.arange(r + 1)
-        criterion = np.full(r + 1, np.inf)
-        ok = (ts < m) & (ts <= positive)
-        criterion[ok] = res2[ok] / (m - ts[ok]) ** 2.0
-        criterion[0] = np.inf
-        t = int(np.argmin(criterion))
-        used = rule
-    elif rule == "discrepancy":
-        if noise_std is None:
-            raise ValueError("the discrepancy principle needs the noise level (noise_std)")
-        delta = float(np.sqrt(np.sum(np.broadcast_to(np.asarray(noise_std, float), b.shape) ** 2)))
-        ok = np.flatnonzero(np.sqrt(res2[1:positive + 1]) <= tau * delta)
-        t = int(ok[0]) + 1 if ok.size else positive
-        used = rule
-    else:
-        raise ValueError(f"unknown truncation rule {rule!r} (known: {', '.join(RULES)})")
-    if t < 1:
-        raise IdentificationError("G is zero: nothing can be identified")
-    f = (np.arange(r) < t).astype(float)
-    x = Vt[:t].T @ (beta[:t] / s[:t])
-    return TSVDSolution(x=x, t=t, singular_values=s, filter_factors=f, rule=used, U=U, Vt=Vt,
-                        residual_norms=np.sqrt(res2), criterion=criterion)
 
 
 def _validate(meas, robot, p):
@@ -498,86 +360,4 @@ def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rt
             k += 1
             _, est, status, info = _estimate(errors, names, prior, sol, S[j], T, P3[j], mp[j])
             out[i] = _lean(errors, names, est, status, info)
-    return out
-
-
-def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_noise) -> dict:
-    """TSVD's covariance with what it leaves out: linearisation bias and truncated directions' bias bound.
-
-    Returns a dict: ``_covariance`` (total), ``_std_kind``, ``_exact`` (the exact
-    whitened model), ``_basis`` (kept directions, scaled), ``_evaluated_at``,
-    ``_chi2_at_estimate`` and the JSON-ready ``info`` entries
-    ``covariance_noise``, ``linearisation_bias``, ``truncation_bias_bound``,
-    ``std_components``, ``std_note``, ``fit_point``, ``fit_basis``, ``prior``, ``noise``.
-    """
-    from zerocal_sym.identify import fitcheck
-    from zerocal_sym.model.noise import NoiseModel
-
-    errors = robot.errors
-    nm = NoiseModel() if noise is None else noise
-    exact = fitcheck._Exact(robot, meas.theta_cmd, meas.readings, names, prior_eff, nm)
-    sc = exact.scale
-    p, t = len(names), sol.t
-    basis = sol.Vt[:t].T
-    z_est = est * sc
-    r_est = exact.evaluate(z_est)[0]
-    out = {"_exact": exact, "_basis": basis, "_chi2_at_estimate": float(r_est @ r_est),
-           "_std_kind": "total" if noise is not None else "from residuals",
-           "prior": prior_eff.tolist(), "noise": {"sigma_scale_mm": nm.sigma_scale_mm,
-                                                  "sigma_servo_rad": nm.sigma_servo_rad},
-           "fit_basis": basis.tolist(),
-           "covariance_noise": None if cov_noise is None else np.asarray(cov_noise).tolist()}
-    notes = []
-    b_lin = np.full(p, np.nan)
-    bound = np.zeros(p)
-    trunc = np.zeros((p, p))
-    z_ref = z_est
-    try:
-        z_ref = exact.refine(z_est, basis)
-        b_lin = est - z_ref / sc
-        if t < p:
-            z_full = exact.refine(z_ref, None)
-            lin = exact.linear(z_full)
-            Finv = np.linalg.pinv(lin.J.T @ lin.J)
-            if nm.is_zero:  # unit weights: the noise level from the residuals of the full fit
-                Finv = Finv * (float(lin.r @ lin.r) / lin.dof if lin.dof > 0 else np.nan)
-            for i in range(t, p):
-                v = sol.Vt[i]
-                c = float(v @ (z_full - z_ref))
-                bi = abs(c) + 2.0 * float(np.sqrt(max(v @ Finv @ v, 0.0)))
-                u = v / sc
-                trunc += bi**2 * np.outer(u, u)
-                bound = np.sqrt(bound**2 + (bi * u) ** 2)
-    except (FloatingPointError, np.linalg.LinAlgError, ValueError) as exc:
-        notes.append(f"the exact-model refinement failed ({exc}): the linearisation and truncation biases are not "
-                     "in the std")
-    if not (np.all(np.isfinite(b_lin)) and np.all(np.isfinite(trunc))):
-        out["_std_kind"] = "lower bound"
-        if not notes:
-            notes.append("the truncated directions' bias could not be bounded: it is not in the std")
-        b_lin = np.where(np.isfinite(b_lin), b_lin, 0.0)
-        trunc = np.where(np.isfinite(trunc), trunc, 0.0)
-        bound = np.where(np.isfinite(bound), bound, 0.0)
-    if cov_noise is None:
-        cov = None
-        out["_std_kind"] = "lower bound"
-        notes.append("no noise model and no spare degree of freedom: the noise part of the std is unknown")
-    else:
-        cov = np.asarray(cov_noise) + np.outer(b_lin, b_lin) + trunc
-    noise_sd = (np.sqrt(np.diag(cov_noise)) if cov_noise is not None else np.full(p, np.nan))
-    out["_covariance"] = cov
-    out["_evaluated_at"] = ("the exact-model minimum over TSVD's kept directions (Gauss-Newton from its estimate)"
-                            if np.any(z_ref != z_est) else "estimate")
-    out["fit_point"] = (z_ref / sc).tolist()
-    out["linearisation_bias"] = b_lin.tolist()
-    out["truncation_bias_bound"] = bound.tolist()
-    out["std_components"] = {
-        n: {"noise": None if not np.isfinite(noise_sd[k]) else errors.to_user_value(n, float(noise_sd[k])),
-            "linearisation_bias": errors.to_user_value(n, float(b_lin[k])),
-            "truncation_bias_bound": errors.to_user_value(n, float(bound[k])),
-            "unit": errors[n].user_unit}
-        for k, n in enumerate(names)}
-    out["std_note"] = ("; ".join(notes) if notes else
-                       "std = sqrt(noise^2 + linearisation bias^2 + truncation bias bound^2) per parameter "
-                       "(covariance: noise + b b^T + bound terms)")
     return out

@@ -1,0 +1,182 @@
+"""What a rejected fit check says: its likely causes, the paragraph, the verdict in the result.
+
+:func:`finish` adds the causes (:func:`_diagnose`: the user's bounds or prior
+against the data, readings of the wrong sign or cumulative, poses out of
+order, one bad reading -- each an exact-model refit) and the paragraph
+(``fit["diagnosis"]``) to the statistics of :func:`~zerocal_sym.identify.fitstats.statistics`;
+:func:`apply` records the fit in a result and, when it is rejected, changes
+its ``success`` and ``status``.  The causes and when each is detected:
+:mod:`zerocal_sym.identify.fitcheck`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from zerocal_sym.identify.chi2 import chi2_sf
+from zerocal_sym.identify.exact_refits import _Exact, _without_each
+from zerocal_sym.identify.fitstats import _fmt_p
+
+
+def _variants(K: int, theta, readings):
+    """(key, description, theta, readings) of the cheap alternative readings of the data."""
+    R = np.asarray(readings, float)
+    yield ("sign", "the readings have the wrong sign (scale mounted or read reversed)", None, -R)
+    yield ("cumulative", "the readings are cumulative (the head was not reset after each reading)", None,
+           np.concatenate([[0.0], np.diff(R)]))
+    yield ("reversed", "the poses were visited in the reverse order of the file", theta[::-1].copy(), None)
+    if K <= 40:
+        for j in range(K - 1):
+            th = theta.copy()
+            th[[j, j + 1]] = th[[j + 1, j]]
+            yield (f"swap{j}", f"poses {j} and {j + 1} were visited in the other order", th, None)
+
+
+def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tuple:
+    """(causes, paragraph) of a rejected fit."""
+    chi2, dof = fit["chi2"], fit["dof"]
+    causes = []
+    active = fit.get("active_bounds") or []
+    if exact is not None and (active or np.any(exact.w)):
+        # the user's constraints (an active bound, a Gaussian prior) against the data: the free fit
+        what = ([f"the bound on {', '.join(active)} (active at the estimate)"] if active else []) + \
+               (["the Gaussian prior"] if np.any(exact.w) else [])
+        try:
+            free = _Exact(exact.robot, exact.theta, exact.readings, exact.names, exact.prior_q, exact.noise)
+            c, d = free.chi2_fit()
+            p = chi2_sf(c, d) if d > 0 else float("nan")
+        except Exception:  # noqa: BLE001
+            c, d, p = float("nan"), 0, float("nan")
+        if np.isfinite(p) and p >= alpha:
+            causes.append({"cause": "constraints", "detected": True,
+                           "text": " and ".join(what) + " contradict(s) the data",
+                           "evidence": f"without them chi2 = {c:.4g} on {d} dof (p = {_fmt_p(p)})"})
+        return causes, _paragraph(fit, causes, alpha, exact)
+    if exact is not None:
+        best = None
+        for key, text, th, rd in _variants(exact.K, exact.theta, exact.readings):
+            try:
+                c, d = exact.chi2_fit(th, rd)
+            except Exception:  # noqa: BLE001 - an alternative that cannot be evaluated explains nothing
+                continue
+            if d <= 0 or not np.isfinite(c):
+                continue
+            p = chi2_sf(c, d)
+            if p >= alpha and c < chi2 and (best is None or p > best[3]):
+                best = (key, text, c, p, d)
+        if best is not None:
+            key, text, c, p, d = best
+            causes.append({"cause": "out of order" if key.startswith("swap") or key == "reversed" else key,
+                           "detected": True, "text": text,
+                           "evidence": f"refitted so, chi2 = {c:.4g} on {d} dof (p = {_fmt_p(p)})"})
+    # one bad reading: exact refits, each without one reading (from the prior: an outlier may have dragged
+    # the estimate far along a weak direction, where the linearisation at the estimate says little)
+    if exact is not None and dof >= 2 and not causes:
+        K1 = exact.K - 1
+        try:
+            out = _without_each(exact, z_est)
+        except Exception:  # noqa: BLE001 - then no reading is named
+            out = None
+        if out is not None:
+            pk = np.array([chi2_sf(c, d) if d > 0 and np.isfinite(c) else np.nan
+                           for c, d in zip(out["chi2"], out["dof"])])
+            ok = [j for j in range(K1) if np.isfinite(pk[j]) and pk[j] >= alpha and out["chi2"][j] < chi2]
+            if ok:
+                j = max(ok, key=lambda j: pk[j])
+                k = j + 1
+                e = float(out["dropped_error_mm"][j, j])
+                c, d = float(out["chi2"][j]), int(out["dof"][j])
+                text = (f"the reading at pose {k} (the change from pose {k - 1} to pose {k}) is off by about "
+                        f"{e:+.3g} mm")
+                ev = f"without it chi2 = {c:.4g} on {d} dof (p = {_fmt_p(pk[j])})"
+                others = [i + 1 for i in ok if i != j]
+                if others:
+                    ev += f"; without the reading at pose {', '.join(map(str, others))} instead it would fit too"
+                causes.append({"cause": "bad reading", "detected": True, "pose": int(k), "from_pose": int(k - 1),
+                               "estimated_error_mm": e, "text": text, "evidence": ev,
+                               "also_possible": [int(o) for o in others]})
+    return causes, _paragraph(fit, causes, alpha, exact)
+
+
+def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
+    chi2, dof = fit["chi2"], fit["dof"]
+    detected = [c for c in causes if c["detected"]]
+    ratio = chi2 / dof if dof > 0 else float("inf")
+    head = (f"The noise model rejects this fit: chi2 = {chi2:.4g} on {dof} degrees of freedom "
+            f"(p = {_fmt_p(fit['p_value'])} < {alpha:g}); the residuals are about {math.sqrt(ratio):.3g} times "
+            "the noise the noise model states.")
+    if detected:
+        c = detected[0]
+        body = f" Likely cause (detected): {c['text']}: {c['evidence']}."
+        if c["cause"] == "bad reading":
+            body += (" (A robot-file error that shows mostly in this change looks the same in one round: "
+                     f"re-measure pose {c['pose']} to tell.)")
+        others = "Otherwise check the robot file, the noise model and the readings."
+        return head + body + " " + others
+    parts = []
+    if dof == 1:
+        parts.append("a bad reading (with one spare degree of freedom every reading explains the misfit equally, "
+                     "so none can be named; more poses would tell)")
+    elif dof >= 2:
+        w = fit.get("worst") or {}
+        if w:
+            parts.append(f"more than one bad reading (the largest standardised residual, {w['standardised']:+.3g} "
+                         f"at pose {w['pose']}, does not explain the misfit alone)")
+    parts.append("a wrong robot file (a geometry that is not this robot's leaves a systematic misfit)")
+    parts.append(f"a noise model that understates the noise (by about {math.sqrt(ratio):.3g} x in standard "
+                 "deviation; scale error {:.3g} um, servo error {:.3g} deg per joint as given)".format(
+                     fit["noise"]["sigma_scale_mm"] * 1e3, math.degrees(fit["noise"]["sigma_servo_rad"])))
+    if fit.get("active_bounds") or (exact is not None and np.any(exact.w)):
+        parts.insert(0, "the bounds or the prior given (they hold the estimate where the data do not agree; the "
+                        "fit without them does not pass either)")
+        checked = ""
+    else:
+        checked = ("Checked and not found: poses visited in reverse or two consecutive poses swapped, cumulative "
+                   "readings (head not reset), sign-flipped readings." if exact is not None else "")
+    return head + " Likely causes: " + "; ".join(parts) + ". " + checked
+
+
+def _summary(fit: dict) -> str:
+    s = f"chi2 {fit['chi2']:.4g} on {fit['dof']} dof, p = {_fmt_p(fit['p_value'])} < {fit['alpha']:g}"
+    det = [c for c in fit.get("causes", []) if c.get("detected")]
+    if det:
+        s += f"; likely: {det[0]['text']}"
+    return s
+
+
+def finish(fit: dict, exact: _Exact | None, diagnose: bool = True, z_est=None) -> dict:
+    """Add the causes and the paragraph to a rejected fit; drop the private arrays."""
+    fit["causes"], fit["diagnosis"] = [], None
+    if fit["rejected"]:
+        if diagnose:
+            fit["causes"], fit["diagnosis"] = _diagnose(exact, fit, fit["alpha"], z_est)
+        else:
+            fit["diagnosis"] = _diagnose(None, fit, fit["alpha"])[1]
+    elif fit["checked"]:
+        fit["diagnosis"] = (f"The fit agrees with the noise model: chi2 = {fit['chi2']:.4g} on {fit['dof']} dof "
+                            f"(p = {_fmt_p(fit['p_value'])}).")
+    else:
+        fit["diagnosis"] = fit["reason"]
+    fit.pop("_t", None)
+    return fit
+
+
+def apply(result, fit: dict, accept_misfit: bool = False):
+    """Record ``fit`` in ``result.info["fit"]`` and, if rejected, change ``status`` / ``success``.
+
+    Only a result that was a calibration (``success``) can be rejected; a
+    failed identification keeps its own status.  Returns ``result``.
+    """
+    result.info["fit"] = fit
+    det = [c for c in fit.get("causes", []) if c.get("detected")]
+    if not result.success and det:  # a failed identification: say what the data look like
+        result.status += f"; the data look wrong: {det[0]['text']} ({det[0]['evidence']})"
+    if fit["rejected"] and result.success:
+        if accept_misfit:
+            fit["accepted_despite_misfit"] = True
+            result.status = f"accepted despite misfit ({_summary(fit)}); {result.status}"
+        else:
+            result.success = False
+            result.status = f"rejected: the noise model rejects the fit ({_summary(fit)})"
+    return result

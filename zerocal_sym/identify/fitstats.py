@@ -1,0 +1,206 @@
+"""The linearised, whitened problem of a fit check and its statistics.
+
+:class:`_Linear` is the whitened problem at the fit check's evaluation point
+(whitened residuals and Jacobian, the whitener of the data rows or its banded
+Cholesky factor, the rank of the Jacobian); :meth:`_Linear.per_reading` gives
+each reading's mean-shift statistic, leverage, estimated error and the move of
+the parameters without it.  :func:`statistics` is the chi² test and the
+per-reading statistics as the JSON-ready dict a result carries in
+``info["fit"]``.  The test, the statistics and their definitions:
+:mod:`zerocal_sym.identify.fitcheck`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from zerocal_sym.identify.chi2 import _gamma_pq, chi2_sf
+
+#: significance level of the fit check (reject when p < alpha)
+DEFAULT_ALPHA = 1e-3
+#: a reading whose mean-shift information is below this fraction of its own is not testable (leverage ~1)
+LEVERAGE_TOL = 1e-9
+#: relative singular-value threshold for the rank of the whitened Jacobian
+RANK_RTOL = 1e-9
+
+
+def band_whitener(l, b) -> np.ndarray:
+    """``L^-1`` for the lower-bidiagonal Cholesky factor (diagonal ``l``, sub-diagonal ``b``), dense."""
+    l = np.ravel(np.asarray(l, float))
+    n = l.size
+    L = np.diag(l)
+    if n > 1:
+        L.ravel()[n::n + 1] = np.ravel(b)[: n - 1]   # the sub-diagonal
+    return np.linalg.inv(L)
+
+
+class _Linear:
+    """The whitened problem at the evaluation point of a fit check.
+
+    ``r`` (N,) whitened residuals, data rows first (n of them) then the prior
+    rows; ``J`` (N, c) whitened Jacobian w.r.t. the fitted coordinates;
+    ``W`` (n, n) the whitener of the data rows, or None with ``band=(l, b)``,
+    the banded Cholesky factor it is the inverse of (``W`` is then built
+    only if asked for); ``poses`` (n,) the pose index k of each data row;
+    ``raw`` (n,) residuals in mm; ``basis`` (p, c) maps the fitted
+    coordinates to the scaled parameters ``z`` (``p = z / scale``).
+    ``svd``: the caller's thin SVD of ``J`` (its U may carry extra zero rows
+    below); ``terms``: the per-reading statistics ``(t, leverage, delta,
+    move)`` computed without ``W`` (``nlls_problem._fit_terms``; full column
+    rank, no prior rows).
+    """
+
+    def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None,
+                 band=None, terms=None):
+        self.r = np.asarray(r, float)
+        self.J = np.atleast_2d(np.asarray(J, float))
+        self.poses = np.asarray(poses, int)
+        self.raw = np.asarray(raw, float)
+        self.basis = np.asarray(basis, float)
+        self.scale = np.asarray(scale, float)
+        self.names = tuple(names)
+        self.n = self.poses.size
+        self.n_prior_rows = int(n_prior_rows)
+        self.point = point
+        self._W, self._band, self._terms = (None if W is None else np.asarray(W, float)), band, terms
+        if W is None and band is None:
+            raise ValueError("_Linear needs W or band")
+        if self._W is not None:
+            w_ok = bool(np.isfinite(self._W).all())
+        else:
+            l, b = (np.ravel(np.asarray(x, float)) for x in band)
+            w_ok = bool(np.isfinite(l).all() and np.isfinite(b).all() and np.all(l != 0))
+        #: False when the exact model cannot be evaluated there (a pose is not an assembly with these errors)
+        self.valid = bool(np.isfinite(self.r).all() and np.isfinite(self.J).all() and w_ok)
+        if not self.valid:
+            self.r = np.where(np.isfinite(self.r), self.r, 0.0)
+            self.J = np.where(np.isfinite(self.J), self.J, 0.0)
+            self._W = np.where(np.isfinite(self.W), self.W, 0.0)
+            svd, self._terms = None, None
+        if svd is None:
+            U, s, Vt = np.linalg.svd(self.J, full_matrices=False)
+        else:
+            U, s, Vt = svd
+            U = U[: self.J.shape[0]]
+        tol = RANK_RTOL * (s[0] if s.size else 0.0)
+        self.rank = int(np.count_nonzero(s > tol)) if s.size else 0
+        self.U, self.s, self.Vt = U[:, : self.rank], s[: self.rank], Vt[: self.rank]
+        self.dof = self.n + self.n_prior_rows - self.rank
+        if self._terms is not None and (self.rank != self.J.shape[1] or self.n_prior_rows
+                                        or self.r.size != self.n):
+            self._terms = None  # the terms assume full column rank and no prior rows
+
+    @property
+    def W(self) -> np.ndarray:
+        """The whitener of the data rows (n, n), dense (built on first use from ``band``)."""
+        if self._W is None:
+            try:
+                with np.errstate(all="ignore"):
+                    self._W = band_whitener(*self._band)
+            except np.linalg.LinAlgError:  # a zero on the diagonal: no whitener (the fit is not valid)
+                self._W = np.full((self.n, self.n), np.nan)
+        return self._W
+
+    def indicator(self, j) -> np.ndarray:
+        """Whitened indicator ``a`` of data row j (N,)."""
+        a = np.zeros(self.r.size)
+        a[: self.n] = self.W[:, j]
+        return a
+
+    def per_reading(self, moves: bool = True):
+        """``(t, leverage, delta, dz)`` for every data row: the mean-shift statistic, leverage,
+        estimated error of the reading (mm) and the change of ``z`` (n, p) when the reading is removed
+        (None with ``moves=False``)."""
+        n = self.n
+        if self._terms is not None:  # O(n p), from the banded factor (the same quantities, no n x n matrix)
+            t, lev, delta, move = self._terms
+            t, lev, delta = np.ravel(t), np.ravel(lev), np.ravel(delta)
+            dz = (self.basis @ np.reshape(move, (self.J.shape[1], n), order="F")).T if moves else None
+            return t, lev, delta, dz
+        A = np.zeros((self.r.size, n))
+        A[:n] = self.W                             # column j: the whitened indicator a_j
+        aa = np.sum(A * A, axis=0)
+        UA = self.U.T @ A                          # (rank, n)
+        den = aa - np.sum(UA * UA, axis=0)         # a^T (I - H) a
+        num = A.T @ self.r - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
+        # F^+ J^T a_j: the move of the coordinates per unit error of reading j
+        Q = self.Vt.T @ (UA / self.s[:, None]) if self.rank else None
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lev = np.where(aa > 0, 1.0 - den / aa, 1.0)
+            ok = den > LEVERAGE_TOL * aa
+            t = np.where(ok, num / np.sqrt(np.where(ok, den, 1.0)), np.nan)
+            delta = np.where(ok, num / np.where(ok, den, 1.0), np.nan)
+        # the fit with a free error on reading j moves the coordinates by F^+ J^T a_j delta_j
+        dz = (self.basis @ (Q * delta[None, :])).T if self.rank else np.full((n, self.basis.shape[0]), np.nan)
+        dz[~ok] = np.nan
+        return t, lev, delta, dz
+
+
+def _noise_dict(noise) -> dict:
+    return {"sigma_scale_mm": float(noise.sigma_scale_mm), "sigma_servo_rad": float(noise.sigma_servo_rad)}
+
+
+def _fmt_p(p) -> str:
+    if p is None or not np.isfinite(p):
+        return "n/a"
+    return "< 1e-300" if p == 0.0 else f"{p:.3g}"
+
+
+def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
+    """The chi² test and the per-reading statistics of a linearised, whitened fit (JSON-ready dict).
+
+    Keys: ``checked``, ``reason`` (why not, if not), ``chi2``, ``dof``,
+    ``p_value``, ``p_value_lower``, ``alpha``, ``rejected``, ``rms_whitened``,
+    ``readings`` (per reading: ``pose``, ``from_pose``, ``residual_mm``,
+    ``whitened``, ``leverage``, ``standardised``, ``estimated_error_mm``),
+    ``worst`` (the reading with the largest ``|standardised|``, with the chi²
+    and p-value without it), ``warnings``, ``noise``, ``model``.
+    """
+    chi2 = float(lin.r @ lin.r) if lin.valid else float("inf")
+    dof = int(lin.dof)
+    zero = noise.is_zero
+    t, lev, delta, _ = lin.per_reading(moves=False)
+    if not lin.valid:
+        t[:], delta[:] = np.nan, np.nan
+    fit = {"model": "exact", "alpha": float(alpha), "chi2": chi2, "dof": dof, "p_value": None,
+           "p_value_lower": None, "checked": False, "reason": None, "rejected": False,
+           "rms_whitened": float(math.sqrt(chi2 / dof)) if dof > 0 else None,
+           "noise": _noise_dict(noise), "warnings": [], "accepted_despite_misfit": False}
+    if zero:
+        fit["reason"] = ("the noise model is zero (noise-free weighting by 1 um): there is no noise level to test "
+                         "the residuals against, so the fit cannot be checked")
+        if dof > 0:  # internally studentised: the noise level estimated from the residuals
+            t = t / math.sqrt(chi2 / dof) if chi2 > 0 else t
+    elif not lin.valid:
+        fit.update(checked=True, p_value=0.0, p_value_lower=1.0, rejected=True,
+                   reason="the exact model cannot be evaluated at the estimate (a pose is not an assembly of the "
+                          "robot with these errors): the estimate is nonsense")
+    elif dof <= 0:
+        fit["reason"] = "the fit cannot be checked (no spare degrees of freedom)"
+    else:
+        pl, p = _gamma_pq(0.5 * dof, 0.5 * chi2)   # lower and upper tails at once (chi2_cdf, chi2_sf)
+        fit.update(checked=True, p_value=p, p_value_lower=pl, rejected=bool(p < alpha))
+        if pl < alpha:
+            fit["warnings"].append(
+                f"chi2 = {chi2:.4g} is far below its {dof} degrees of freedom (lower-tail p = {_fmt_p(pl)}): the "
+                "noise model overstates the noise, so the standard deviations are too large (conservative)")
+    n = lin.n
+    tt = np.where(np.isfinite(t), t, np.nan).tolist()
+    dd = np.where(np.isfinite(delta), delta, np.nan).tolist()
+    fit["readings"] = [{"pose": k, "from_pose": k - 1, "residual_mm": e, "whitened": w, "leverage": v,
+                        "standardised": None if ts != ts else ts, "estimated_error_mm": None if ds != ds else ds}
+                       for k, e, w, v, ts, ds in zip(lin.poses[:n].tolist(), lin.raw[:n].tolist(), lin.r[:n].tolist(),
+                                                     lev[:n].tolist(), tt, dd)]
+    fit["worst"] = None
+    at = np.where(np.isfinite(t), np.abs(t), -1.0)
+    if at.size and at.max() >= 0.0:
+        j = int(np.argmax(at))
+        w = {"pose": int(lin.poses[j]), "from_pose": int(lin.poses[j]) - 1, "standardised": float(t[j]),
+             "estimated_error_mm": float(delta[j]), "chi2_without": None, "p_value_without": None}
+        if fit["checked"] and dof >= 2:
+            c = max(chi2 - float(t[j]) ** 2, 0.0)
+            w.update(chi2_without=c, p_value_without=chi2_sf(c, dof - 1))
+        fit["worst"] = w
+    fit["_t"] = t  # private: for the diagnosis (removed before returning to the user)
+    return fit
