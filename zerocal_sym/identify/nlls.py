@@ -45,6 +45,7 @@ import time
 import numpy as np
 
 from zerocal_sym.identify import fisher, fitcheck
+from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.identify.nlls_problem import get_problem
@@ -123,7 +124,7 @@ def _initial(robot, meas, names, prior_q, warm_start):
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
                   bounds=None, prior_std=None, warm_start=None, reweight: int = 1,
                   max_iter: int | None = None, prior_cov=None, loss: str = "l2", loss_scale: float | None = None,
-                  fit_alpha: float = fitcheck.DEFAULT_ALPHA, accept_misfit: bool = False) -> IdentificationResult:
+                  fit_alpha: float = DEFAULT_ALPHA, accept_misfit: bool = False) -> IdentificationResult:
     """Maximum-likelihood (or MAP) identification with Ipopt on the exact model.
 
     Parameters
@@ -209,9 +210,9 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     delta = None
     if loss != "l2":
-        from zerocal_sym.identify.robust import DEFAULT_SCALE
+        from zerocal_sym.identify import robust as rb
 
-        delta = DEFAULT_SCALE[loss] if loss_scale is None else float(loss_scale)
+        delta = rb.DEFAULT_SCALE[loss] if loss_scale is None else float(loss_scale)
         if not delta > 0:
             raise ValueError(f"loss_scale must be positive, got {loss_scale!r}")
         if bounds is not None:
@@ -293,7 +294,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     robust = None
     if loss != "l2":  # from the l2 solution, or from the prior when Ipopt failed (an outlier can cause that)
         z_start = z if (converged and np.all(np.isfinite(z))) else mu * scale
-        z, robust, ok = _robust(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta, w, K)
+        z, robust, ok = rb.robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta,
+                                        w, K)
         robust["l2_solver_status"] = ret
         if not ok:
             converged, ret = False, "robust iteration did not converge"
@@ -388,7 +390,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         terms = None
         if not rows.size and rank == len(names) and "fit_terms" in fast:  # the per-reading terms, O(K p)
             terms = [o.copy() for o in fast["fit_terms"](r, Jd, l, b)]
-        lin = fitcheck._Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
+        lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
                                np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
                                None, np.arange(1, K), s - pred, np.eye(len(names)),
                                scale, names, len(rows), band=(l, b),
@@ -396,7 +398,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                                terms=terms)
         at = "estimate"
     else:
-        lin = _robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
+        lin = rb.robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
         at = ("estimate, without the readings the robust loss down-weighted (at pose "
               f"{', '.join(map(str, robust['excluded_readings']))})" if robust["excluded_readings"] else "estimate")
         info["robust"] = {k: v for k, v in robust.items() if not k.startswith("_")}
@@ -407,71 +409,6 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                           prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     info["time_s"] = time.perf_counter() - t0
     return res
-
-
-def _robust(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delta, w, K):
-    """Robust stage (:mod:`zerocal_sym.identify.robust`).
-
-    Candidates: IRLS from the l2 solution; IRLS from the best exact fit
-    without one reading (a large outlier drags the l2 solution far along a
-    weak direction); that deletion fit itself, if the loss down-weights the
-    reading it left out there (an outlier with high leverage drags IRLS off
-    it: Huber's loss bounds a reading's influence, not its leverage).  The
-    readings a candidate down-weights below ROBUST_EXCLUDE_WEIGHT are its
-    outliers, and its estimate is the exact fit without them.  Between
-    candidates: one whose fit without its outliers passes the fit check, then
-    the fewest outliers, then the lower robust objective.
-
-    Returns ``(z, info, converged)``.
-    """
-    from zerocal_sym.identify import robust as rb
-
-    pw = w if np.any(w) else None
-    args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
-    cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
-    if K - 2 > len(names):
-        drop = fitcheck.refits(*args, [[j] for j in range(K - 1)], z_l2, prior_whitener=pw)
-        if np.any(np.isfinite(drop["chi2"])):
-            j = int(np.argmin(drop["chi2"]))
-            cands += [(drop["z"][j], None), (drop["z"][j], j)]
-    best = None
-    for z0, j in cands:
-        out = rb.irls(*args, z0, loss, delta, prior_whitener=pw, max_iter=100 if j is None else 0)
-        if j is None:
-            excl = np.flatnonzero(out["weights"] < fitcheck.ROBUST_EXCLUDE_WEIGHT)
-        else:  # the best single deletion itself (an outlier with high leverage drags IRLS off it)
-            excl = np.array([j]) if out["weights"][j] < fitcheck.ROBUST_EXCLUDE_WEIGHT else np.zeros(0, int)
-            out["converged"] = True
-        ref = fitcheck.refits(*args, [excl], out["z"], prior_whitener=pw, max_iter=50 if excl.size else 0,
-                              tol=GN_STEP_TOL)
-        c, d = float(ref["chi2"][0]), int(ref["dof"][0])
-        passes = bool(d > 0 and np.isfinite(c) and fitcheck.chi2_sf(c, d) >= fitcheck.DEFAULT_ALPHA)
-        key = (bool(out["converged"]), passes, -excl.size, -out["objective"])
-        if best is None or key > best[0]:
-            best = (key, out, excl, ref)
-    _, out, excl, ref = best
-    z, ok = out["z"], out["converged"]
-    C, refit = out["C"], False
-    err_mm = out["conditional_residual_mm"][excl]
-    if ok and excl.size and ref["converged"][0]:  # the outliers named: the estimate is the exact fit without them
-        z, refit = ref["z"][0], True
-        e, _, C = rb._Model(robot, theta_cmd, meas.readings, names, prior_q, noise, pw).at(z)
-        err_mm = rb.conditional_residuals(e, C, np.zeros(K - 1))[0][excl]
-    return z, {
-        "loss": loss, "scale_sigmas": float(delta), "iterations": int(out["iterations"]),
-        "converged": bool(ok), "weights": out["weights"].tolist(), "standardised": out["u"].tolist(),
-        "excluded_readings": [int(j) + 1 for j in excl], "excluded_errors_mm": [float(v) for v in err_mm],
-        "refit_without_outliers": refit, "_C": C, "_C_w": out["C_w"],
-    }, ok
-
-
-def _robust_linear(robust, e, A, Jp, rp, scale, names, K):
-    """The fit check's problem of a robust fit: the readings it down-weighted removed (by marginalising C)."""
-    keep = np.setdiff1d(np.arange(K - 1), np.asarray(robust["excluded_readings"], int) - 1)
-    C = robust["_C"][np.ix_(keep, keep)]
-    W = np.linalg.solve(np.linalg.cholesky(C), np.eye(keep.size))
-    return fitcheck._Linear(np.concatenate([W @ e[keep], rp]), np.vstack([W @ -A[keep], Jp]), W, keep + 1, e[keep],
-                            np.eye(len(names)), scale, names, len(rp))
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):

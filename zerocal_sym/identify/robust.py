@@ -1,6 +1,6 @@
 """Robust identification: iteratively reweighted Gauss-Newton on the exact model.
 
-``identify_nlls(..., loss="huber" | "soft_l1", loss_scale=...)`` calls
+``identify_nlls(..., loss="huber" | "soft_l1", loss_scale=...)`` calls :func:`robust_stage`, which runs
 :func:`irls` after its l2 solution.  The changes are correlated (consecutive
 changes share a pose's servo error), so a robust loss on the *whitened*
 residuals would not isolate a bad reading (whitening mixes it into the
@@ -167,3 +167,74 @@ def irls(robot, theta_cmd, readings, names, prior_q, noise, z0, loss: str = "hub
     om = weights(loss, u, delta)  # at the final point (max_iter = 0: the classification at z0)
     return {"z": z, "objective": float(np.sum(loss_value(loss, u, delta))), "weights": om, "u": u, "conditional_residual_mm": c, "C": C, "C_w": C + np.diag(infl),
             "A": A, "e": e, "iterations": it, "converged": bool(converged and np.all(np.isfinite(z)))}
+
+
+def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delta, w, K):
+    """The robust stage of :func:`~zerocal_sym.identify.nlls.identify_nlls` (``z_l2``: its l2 solution, scaled).
+
+    Candidates: IRLS from the l2 solution; IRLS from the best exact fit
+    without one reading (a large outlier drags the l2 solution far along a
+    weak direction); that deletion fit itself, if the loss down-weights the
+    reading it left out there (an outlier with high leverage drags IRLS off
+    it: Huber's loss bounds a reading's influence, not its leverage).  The
+    readings a candidate down-weights below ROBUST_EXCLUDE_WEIGHT are its
+    outliers, and its estimate is the exact fit without them.  Between
+    candidates: one whose fit without its outliers passes the fit check, then
+    the fewest outliers, then the lower robust objective.
+
+    Returns ``(z, info, converged)``.
+    """
+    from zerocal_sym.identify.chi2 import chi2_sf
+    from zerocal_sym.identify.exact_refits import refits
+    from zerocal_sym.identify.fitcheck import ROBUST_EXCLUDE_WEIGHT
+    from zerocal_sym.identify.fitstats import DEFAULT_ALPHA
+    from zerocal_sym.identify.nlls import GN_STEP_TOL
+
+    pw = w if np.any(w) else None
+    args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
+    cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
+    if K - 2 > len(names):
+        drop = refits(*args, [[j] for j in range(K - 1)], z_l2, prior_whitener=pw)
+        if np.any(np.isfinite(drop["chi2"])):
+            j = int(np.argmin(drop["chi2"]))
+            cands += [(drop["z"][j], None), (drop["z"][j], j)]
+    best = None
+    for z0, j in cands:
+        out = irls(*args, z0, loss, delta, prior_whitener=pw, max_iter=100 if j is None else 0)
+        if j is None:
+            excl = np.flatnonzero(out["weights"] < ROBUST_EXCLUDE_WEIGHT)
+        else:  # the best single deletion itself (an outlier with high leverage drags IRLS off it)
+            excl = np.array([j]) if out["weights"][j] < ROBUST_EXCLUDE_WEIGHT else np.zeros(0, int)
+            out["converged"] = True
+        ref = refits(*args, [excl], out["z"], prior_whitener=pw, max_iter=50 if excl.size else 0,
+                              tol=GN_STEP_TOL)
+        c, d = float(ref["chi2"][0]), int(ref["dof"][0])
+        passes = bool(d > 0 and np.isfinite(c) and chi2_sf(c, d) >= DEFAULT_ALPHA)
+        key = (bool(out["converged"]), passes, -excl.size, -out["objective"])
+        if best is None or key > best[0]:
+            best = (key, out, excl, ref)
+    _, out, excl, ref = best
+    z, ok = out["z"], out["converged"]
+    C, refit = out["C"], False
+    err_mm = out["conditional_residual_mm"][excl]
+    if ok and excl.size and ref["converged"][0]:  # the outliers named: the estimate is the exact fit without them
+        z, refit = ref["z"][0], True
+        e, _, C = _Model(robot, theta_cmd, meas.readings, names, prior_q, noise, pw).at(z)
+        err_mm = conditional_residuals(e, C, np.zeros(K - 1))[0][excl]
+    return z, {
+        "loss": loss, "scale_sigmas": float(delta), "iterations": int(out["iterations"]),
+        "converged": bool(ok), "weights": out["weights"].tolist(), "standardised": out["u"].tolist(),
+        "excluded_readings": [int(j) + 1 for j in excl], "excluded_errors_mm": [float(v) for v in err_mm],
+        "refit_without_outliers": refit, "_C": C, "_C_w": out["C_w"],
+    }, ok
+
+
+def robust_linear(robust, e, A, Jp, rp, scale, names, K):
+    """The fit check's problem of a robust fit: the readings it down-weighted removed (by marginalising C)."""
+    keep = np.setdiff1d(np.arange(K - 1), np.asarray(robust["excluded_readings"], int) - 1)
+    from zerocal_sym.identify.fitstats import _Linear
+
+    C = robust["_C"][np.ix_(keep, keep)]
+    W = np.linalg.solve(np.linalg.cholesky(C), np.eye(keep.size))
+    return _Linear(np.concatenate([W @ e[keep], rp]), np.vstack([W @ -A[keep], Jp]), W, keep + 1, e[keep],
+                            np.eye(len(names)), scale, names, len(rp))
