@@ -57,14 +57,35 @@ def input_hash(sources) -> str:
 
 
 def _matrix_code(name: str, mat: sp.Matrix, printer) -> str:
-    rows = []
-    for i in range(mat.rows):
-        rows.append("ca.horzcat(" + ", ".join(printer.doprint(mat[i, j]) for j in range(mat.cols)) + ")")
     if mat.cols == 1:
         body = "ca.vertcat(" + ", ".join(printer.doprint(mat[i, 0]) for i in range(mat.rows)) + ")"
     else:
+        rows = ["ca.horzcat(" + ", ".join(printer.doprint(mat[i, j]) for j in range(mat.cols)) + ")"
+                for i in range(mat.rows)]
         body = "ca.vertcat(\n        " + ",\n        ".join(rows) + ",\n    )"
     return f"    {name} = {body}"
+
+
+def _free_symbols(exprs) -> set:
+    """The union of the ``free_symbols`` of ``exprs``, each distinct subexpression visited once.
+
+    (``Basic.free_symbols`` is the union over the arguments, recomputed at every occurrence of a shared
+    subexpression: most of a second on the Delta's trees.)  A class with its own ``free_symbols`` (an atom,
+    or one with bound variables) answers for itself, so the set is the same.
+    """
+    memo = {}
+
+    def fs(e):
+        r = memo.get(e)
+        if r is None:
+            if type(e).free_symbols is sp.Basic.free_symbols:
+                r = set().union(*(fs(a) for a in e.args))
+            else:
+                r = e.free_symbols
+            memo[e] = r
+        return r
+
+    return set().union(*(fs(e) for e in exprs))
 
 
 def emit_function(fname: str, spec: dict, printer) -> str:
@@ -74,7 +95,7 @@ def emit_function(fname: str, spec: dict, printer) -> str:
     names = [n for n, _ in spec["outputs"]]
     mats = [m for _, m in spec["outputs"]]
     flat = [e for m in mats for e in m]
-    used = set().union(*(e.free_symbols for e in flat))
+    used = _free_symbols(flat)
     for argname, syms in spec["inputs"]:
         for k, s in enumerate(syms):
             if s in used:
@@ -166,7 +187,28 @@ MECHANISMS = {
 }
 
 
-def generate(out_dir: Path | None = None, check_forms: bool = True) -> dict:
+def derive_all(check_forms: bool = True) -> dict:
+    """Derive every mechanism of :data:`MECHANISMS`: ``{name: SymbolicMechanism}``.
+
+    Parameters
+    ----------
+    check_forms : bool
+        Also assert the symbolic reduction to the paper's forms (where a
+        derivation module has ``check_paper_forms``).
+    """
+    import importlib
+
+    derived = {}
+    for name, modname in MECHANISMS.items():
+        mod = importlib.import_module(modname)
+        mech = mod.build()
+        if check_forms and hasattr(mod, "check_paper_forms"):
+            mod.check_paper_forms(mech)
+        derived[name] = mech
+    return derived
+
+
+def generate(out_dir: Path | None = None, check_forms: bool = True, derived: dict | None = None) -> dict:
     """Derive every mechanism and return ``{path: source}`` (nothing written).
 
     Parameters
@@ -175,18 +217,20 @@ def generate(out_dir: Path | None = None, check_forms: bool = True) -> dict:
         Directory the files are meant for (default ``zerocal_sym/generated``).
     check_forms : bool
         Also assert the symbolic reduction to the paper's forms.
+    derived : dict, optional
+        The mechanisms as :func:`derive_all` returns them (derived already,
+        e.g. once for several checks in one process); default: derived here.
     """
     import importlib
 
     out_dir = Path(out_dir) if out_dir else GENERATED_DIR
+    if derived is None:
+        derived = derive_all(check_forms)
     files = {}
     for name, modname in MECHANISMS.items():
         mod = importlib.import_module(modname)
-        mech = mod.build()
-        if check_forms and hasattr(mod, "check_paper_forms"):
-            mod.check_paper_forms(mech)
         sources = [HERE / "mechanism.py", HERE / "codegen.py", Path(mod.__file__)]
-        files[out_dir / f"{name}.py"] = render(mech, sources)
+        files[out_dir / f"{name}.py"] = render(derived[name], sources)
     return files
 
 

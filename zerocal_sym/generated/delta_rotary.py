@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 7aa66b8f5bd57090
+inputs hash: 0f9d626faf28498e
 sympy: 1.14.0
 """
 import casadi as ca

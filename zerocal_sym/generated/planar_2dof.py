@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: 8293b2a0c47ccdf6
+inputs hash: 83d9eac02f563a8e
 sympy: 1.14.0
 """
 import casadi as ca
