@@ -24,3 +24,44 @@ def robot():
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+# ----------------------------------------------------------------------------- the sympy derivation, once
+@pytest.fixture(scope="session")
+def derived():
+    """Every mechanism derived afresh from ``derivations/`` (sympy), once per test process:
+    ``{name: SymbolicMechanism}`` (:func:`derivations.codegen.derive_all`, the paper's forms checked).
+    Read-only: a test that edits a derivation builds its own."""
+    pytest.importorskip("sympy")
+    from derivations import codegen
+
+    return codegen.derive_all()
+
+
+@pytest.fixture(scope="session")
+def generated(derived):
+    """The generated modules a fresh derivation writes, ``{path in zerocal_sym/generated: source}``
+    (:func:`derivations.codegen.generate` on :func:`derived`), once per test process."""
+    from derivations import codegen
+
+    return codegen.generate(derived=derived)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(items):
+    """The notebooks first, then the tests of the session's derivation (the fixtures above), the rest in order.
+
+    ``pytest -n 2`` distributes by work stealing (``--dist worksteal``, pyproject.toml): each worker starts
+    with a contiguous share of this order and, when done, takes the tail of another's.  The long items first
+    keep the tails short, so the two workers end together; the derivation's tests together at the start of
+    the first share run on one worker and share one derivation (a worker that runs only some of them derives
+    for itself: slower, the same checks).
+    """
+    def rank(item):
+        if item.nodeid.endswith(".ipynb") or ".ipynb::" in item.nodeid:
+            return 0
+        if {"derived", "generated"} & set(getattr(item, "fixturenames", ())):
+            return 1
+        return 2
+
+    items[:] = sorted(items, key=rank)  # stable: the collection order within each rank

@@ -173,14 +173,11 @@ def test_monte_carlo_rms_of_the_zero_offsets_is_the_crlb(mrobot, scheme):
 
 
 @pytest.fixture(scope="module")
-def symbolic(mrobot):
-    """The derivation of the mechanism (sympy), built once per mechanism."""
+def symbolic(mrobot, derived):
+    """The derivation of the mechanism (sympy; derived once per test process, tests/conftest.py)."""
     sp = pytest.importorskip("sympy")
-    import importlib
 
-    from derivations.codegen import MECHANISMS
-
-    return sp, importlib.import_module(MECHANISMS[mrobot.mechanism_name]).build()
+    return sp, derived[mrobot.mechanism_name]
 
 
 def test_generated_functions_match_sympy(mrobot, symbolic, rng):

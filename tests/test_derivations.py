@@ -1,8 +1,9 @@
 """The sympy derivations: the paper's forms, staleness of the committed code, its header.
 
-(Generated code against sympy, for every mechanism: tests/test_contract.py.)"""
-import subprocess
-import sys
+(Generated code against sympy, for every mechanism: tests/test_contract.py.)  The derivation is done once per
+test process (the ``derived`` and ``generated`` fixtures of tests/conftest.py): it takes seconds.
+"""
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,11 +12,22 @@ sp = pytest.importorskip("sympy")
 
 from derivations import codegen  # noqa: E402
 from derivations.mechanisms import planar_2dof  # noqa: E402
+from zerocal_sym.cli import main  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def mech():
-    return planar_2dof.build()
+def mech(derived):
+    return derived["planar_2dof"]
+
+
+@pytest.fixture
+def fresh_generate(monkeypatch, generated):
+    """``codegen.generate`` answering with this process's fresh derivation (``generated``), for any directory."""
+    def generate(out_dir=None, check_forms=True, derived=None):
+        out = Path(out_dir) if out_dir else codegen.GENERATED_DIR
+        return {out / path.name: text for path, text in generated.items()}
+
+    monkeypatch.setattr(codegen, "generate", generate)
 
 
 def test_reduces_to_paper_forms(mech):
@@ -33,14 +45,14 @@ def test_paper_form_check_can_fail(mech):
         planar_2dof.check_paper_forms(m)
 
 
-def test_committed_code_is_fresh():
+def test_committed_code_is_fresh(fresh_generate):
     assert codegen.regen(check=True) == [], "generated code is stale: run `zerocal regen`"
 
 
-def test_regen_check_cli_passes_then_fails_after_hand_edit(tmp_path):
+def test_regen_check_cli_passes_then_fails_after_hand_edit(tmp_path, capsys, fresh_generate):
     """One ``regen --check`` over a copy where one file is hand-edited: that one stale, the other up to date.
 
-    (A clean copy passing is test_committed_code_is_fresh; one CLI run here keeps the regeneration to once.)
+    (A clean copy passing is test_committed_code_is_fresh; both compare with the same fresh derivation.)
     """
     out = tmp_path / "gen"
     out.mkdir()
@@ -49,12 +61,12 @@ def test_regen_check_cli_passes_then_fails_after_hand_edit(tmp_path):
         (out / f"{name}.py").write_text(committed.read_text())
     f = out / "planar_2dof.py"
     f.write_text(f.read_text().replace("ca.acos(", "ca.asin(", 1))
-    r = subprocess.run([sys.executable, "-m", "zerocal_sym", "regen", "--check", "--out-dir", str(out)],
-                       capture_output=True, text=True)
-    assert r.returncode == 1
-    stale = [ln for ln in r.stderr.splitlines() if ln.startswith("stale: ")]
-    assert stale == [f"stale: {f}"], r.stderr
-    assert "generated code is stale" in r.stderr
+    rc = main(["regen", "--check", "--out-dir", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 1
+    stale = [ln for ln in err.splitlines() if ln.startswith("stale: ")]
+    assert stale == [f"stale: {f}"], err
+    assert "generated code is stale" in err
     assert len(codegen.MECHANISMS) >= 2  # so the other mechanism's unedited copy was checked and passed
 
 
