@@ -168,16 +168,6 @@ def _fit_terms(n: int, p: int):
                        ["t", "leverage", "delta", "move"])
 
 
-def _cse(f):
-    """``f`` (an SX Function) with its common subexpressions merged (``casadi.cse``): the same operations on
-    the same numbers, so the same bits, in fewer instructions (the weights and the residuals of a
-    Gauss-Newton iteration share the kinematics)."""
-    import casadi as ca
-
-    sx = f.sx_in()
-    return ca.Function(f.name(), sx, ca.cse(f.call(sx)), f.name_in(), f.name_out())
-
-
 class NllsProblem:
     """The cached functions for (mechanism, K, parameter indices)."""
 
@@ -275,7 +265,7 @@ class NllsProblem:
         if fit_terms is not None:
             funcs["fit_terms"] = fit_terms
         if self.expanded:
-            funcs = {k: _cse(f.expand() if k.startswith("nlp") else f) for k, f in funcs.items()}
+            funcs = {k: (f.expand() if k.startswith("nlp") else f) for k, f in funcs.items()}
         # Ipopt's interface builds a gradient of the objective at init: the compiled objective carries its adjoint
         funcs["adj1_nlp_f"] = funcs["nlp_f"].reverse(1)
         self.tier = Tier(funcs, f"nlls-{mechanism.name}-K{K}-" + "_".join(map(str, idx)))
