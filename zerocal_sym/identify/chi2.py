@@ -67,21 +67,20 @@ def chi2_sf(x, dof) -> float:
     ValueError
         ``dof <= 0`` or not finite.
     """
-    dof = float(dof)
-    if not (dof > 0 and math.isfinite(dof)):
-        raise ValueError(f"chi2_sf: dof must be positive, got {dof}")
-    x = float(x)
-    if math.isnan(x):
-        return float("nan")
-    return _gamma_pq(0.5 * dof, 0.5 * x)[1]
+    return _tail(x, dof, 1, "chi2_sf")
 
 
 def chi2_cdf(x, dof) -> float:
     """Distribution function ``P(X <= x)`` (the lower tail, accurate when small)."""
+    return _tail(x, dof, 0, "chi2_cdf")
+
+
+def _tail(x, dof, upper: int, who: str) -> float:
+    """``P(a, x/2)`` (``upper`` 0) or ``Q`` (1) with ``a = dof/2``, the arguments checked (NaN in, NaN out)."""
     dof = float(dof)
     if not (dof > 0 and math.isfinite(dof)):
-        raise ValueError(f"chi2_cdf: dof must be positive, got {dof}")
+        raise ValueError(f"{who}: dof must be positive, got {dof}")
     x = float(x)
     if math.isnan(x):
         return float("nan")
-    return _gamma_pq(0.5 * dof, 0.5 * x)[0]
+    return _gamma_pq(0.5 * dof, 0.5 * x)[upper]

@@ -98,9 +98,12 @@ def _bounds(bounds, names, scale):
     return lo * scale, hi * scale
 
 
-def _initial(robot, meas, names, prior_q, warm_start):
-    """Initial guess (physical units, shape (p,)) and a note on where it came from."""
-    x0 = robot.errors.take(prior_q, names)
+def _initial(robot, meas, names, prior_q, warm_start, prior_values):
+    """Initial guess (physical units, shape (p,)) and a note on where it came from.
+
+    ``prior_values``: ``prior_q`` at ``names`` (the start without a warm start).
+    """
+    x0 = np.array(prior_values, float)
     if warm_start is None:
         return x0, "prior"
     if isinstance(warm_start, str):
@@ -228,7 +231,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                                   f"{robot.name!r} has {robot.m} joints", where=getattr(meas, "source", None))
     s = np.asarray(meas.readings, float)[1:]
     prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
-    scale = robot.error_scale(names)  # fisher.parameter_scale
+    scale = fisher.parameter_scale(robot, names)
     if prior_cov is not None:
         if prior_std is not None:
             raise ValueError("give prior_std or prior_cov, not both")
@@ -253,11 +256,11 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         w = np.diag(1.0 / std)
     prob = get_problem(robot, K, names)
     prob.touch()
-    mu = prior_q[list(prob.idx)]  # errors.take(prior_q, names)
+    mu = errors.take(prior_q, names)
     has_prior = bool(w.any())
     lbx, ubx = _bounds(bounds, list(names), scale)
-    x0, start = (mu.copy(), "prior") if warm_start is None else _initial(robot, meas, names, prior_q, warm_start)
-    z0 = x0 * scale if bounds is None else np.clip(x0 * scale, lbx, ubx)
+    x0, start = _initial(robot, meas, names, prior_q, warm_start, mu)
+    z0 = x0 * scale if bounds is None else np.clip(x0 * scale, lbx, ubx)  # (clipping to +-inf: no-op)
 
     solver = prob.solver_for(max_iter)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
@@ -385,17 +388,17 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                                residuals=np.asarray(s - pred), info=info, errors=errors,
                                std_kind="from residuals" if noise.is_zero else "total")
     # the fit check: whitened exact-model residuals at the estimate against the noise model
-    rows = np.flatnonzero(np.any(w != 0, axis=1)) if has_prior else np.zeros(0, int)
+    rows = np.flatnonzero(np.any(w != 0, axis=1))
     if robust is None:
         terms = None
         if not rows.size and rank == len(names) and "fit_terms" in fast:  # the per-reading terms, O(K p)
             terms = [o.copy() for o in fast["fit_terms"](r, Jd, l, b)]
         lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
-                               np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
-                               None, np.arange(1, K), s - pred, np.eye(len(names)),
-                               scale, names, len(rows), band=(l, b),
-                               svd=None if rows.size else (UJ, sJ, Vt),  # no prior rows: J's SVD is Jd's
-                               terms=terms)
+                      np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
+                      None, np.arange(1, K), s - pred, np.eye(len(names)),
+                      scale, names, len(rows), band=(l, b),
+                      svd=None if rows.size else (UJ, sJ, Vt),  # no prior rows: J's SVD is Jd's
+                      terms=terms)
         at = "estimate"
     else:
         lin = rb.robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
