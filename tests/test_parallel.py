@@ -161,15 +161,37 @@ def test_keyboard_interrupt_stops_compare(robot, workers):
     import multiprocessing
 
     log = []
-    with pytest.raises(KeyboardInterrupt):
-        compare(robot, trials=200, seed=1, methods=("tsvd", "nlls"), workers=workers, chunk=5,
+    with pytest.raises(KeyboardInterrupt):  # 2,000 trials would take a minute or more: what stops them is Ctrl-C
+        compare(robot, trials=2000, seed=1, methods=("tsvd", "nlls"), workers=workers, chunk=5,
                 progress=_interrupting_progress(log))
-    assert len(log) == 1 and time.perf_counter() - log[0] < 1.5  # stopped within a second
-    deadline = time.monotonic() + 3.0  # the workers are gone soon after (a loaded machine reaps them late)
+    # stopped at once (about 0.1 s idle; the bound is loose because the machines are shared and noisy:
+    # the time itself is not what this test measures, but that the run does not go on)
+    assert len(log) == 1 and time.perf_counter() - log[0] < 5.0
+    deadline = time.monotonic() + 10.0  # the workers are gone soon after (a loaded machine reaps them late)
     while multiprocessing.active_children() and time.monotonic() < deadline:
         time.sleep(0.05)
     left = multiprocessing.active_children()
     assert not left, [(p.pid, p.exitcode) for p in left]
+
+
+def test_interrupting_a_pool_prints_no_traceback_from_its_threads(monkeypatch):
+    """Python 3.11's pool manager thread raised InvalidStateError (a traceback on stderr, and an unhandled
+    thread exception under pytest) on a future cancelled while it failed the pending ones; the stop lets it
+    finish first.  Before, the race hit 3 of 20 interrupts of ``compare``, and this test with 12 interrupts
+    failed in 2 of 3 runs."""
+    import threading
+
+    caught = []
+    monkeypatch.setattr(threading, "excepthook", lambda a: caught.append(repr(a.exc_value)))
+    for _ in range(8):
+        before = set(threading.enumerate())
+        log = []
+        with pytest.raises(KeyboardInterrupt):
+            parallel.run_chunks(time.sleep, [0.05] * 200, workers=2, progress=_interrupting_progress(log))
+        for t in set(threading.enumerate()) - before:
+            t.join(10.0)
+            assert not t.is_alive(), t
+    assert caught == []
 
 
 def test_keyboard_interrupt_cli_writes_nothing(tmp_path, capsys, monkeypatch):

@@ -184,13 +184,24 @@ def _run_processes(fn, tasks, workers, finished):
 
 
 def _stop_pool(pool, futs):
-    """Cancel what is pending, terminate the worker processes, shut down without waiting for work."""
-    for f in futs:
-        f.cancel()
+    """Terminate the worker processes, then shut down without waiting for work.
+
+    Nothing is cancelled before the pool's manager thread has seen the
+    terminated workers: it then fails every pending future itself
+    (``BrokenProcessPool``) and ends.  Python 3.11's manager raises
+    ``InvalidStateError`` (a traceback printed from its thread) on a future
+    cancelled while it does so; cancelling first hit that race in 3 of 20
+    interrupts of ``compare`` (one run).
+    """
     procs = list((getattr(pool, "_processes", None) or {}).values())
     for p in procs:
         if p.is_alive():
             p.terminate()
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if procs and manager is not None:
+        manager.join(2.0)  # milliseconds when idle; bounded on a loaded machine
+    for f in futs:
+        f.cancel()
     pool.shutdown(wait=False, cancel_futures=True)
     for p in list((getattr(pool, "_processes", None) or {}).values()):  # one started since the snapshot
         if p not in procs:
