@@ -21,16 +21,6 @@ def test_identify_plot_dir(data_csv, tmp_path, capsys):
     assert (out / "residuals.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_reproduce_out_dir_has_all_figures(tmp_path, capsys):
-    out = tmp_path / "rep"
-    assert main(["reproduce", "--out", str(out), "--noise", "none", "--max-iter", "3"]) == 0
-    names = {p.name for p in out.iterdir()}
-    expected = {"fig8.png", "fig9.png", "results.json"} | {f"fig12_group{g}.png" for g in range(1, 7)} | {
-        f"convergence_group{g}.png" for g in range(1, 7)}
-    assert expected <= names
-    assert not [n for n in names if n.startswith(".")], "temporary files left behind"
-
-
 @pytest.mark.parametrize("argv_tail", [["simulate", "--group", "1", "--out"], ["identify", "DATA", "--out"]])
 def test_output_path_is_a_directory(data_csv, tmp_path, capsys, argv_tail):
     argv = [a if a != "DATA" else str(data_csv) for a in argv_tail] + [str(tmp_path)]

@@ -1,5 +1,7 @@
 """``zerocal design --scheme paper``, ``simulate`` and ``reproduce``."""
 import json
+import os
+import stat
 
 import numpy as np
 import pytest
@@ -91,13 +93,24 @@ def test_reproduce_json(capsys):
 
 def test_reproduce_text_trials_and_out(capsys, tmp_path):
     out_dir = tmp_path / "rep"
-    rc, out, err = run(capsys, "reproduce", "--trials", "2", "--out", str(out_dir))
+    old = os.umask(0o027)  # the directory and its files honour the umask (tests/test_hardening.py for the rest)
+    try:
+        rc, out, err = run(capsys, "reproduce", "--trials", "2", "--out", str(out_dir))
+    finally:
+        os.umask(old)
     assert rc == 0
+    assert stat.S_IMODE(out_dir.stat().st_mode) == 0o750
+    assert {stat.S_IMODE(p.stat().st_mode) for p in out_dir.iterdir()} == {0o640}
     for t in ("Table 3", "Table 4", "Table 5", "Table 6", "±"):
         assert t in out
     assert "reproduce: 12/12 loops" in err
-    for name in ("fig8.png", "fig9.png"):
-        assert (out_dir / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    names = {p.name for p in out_dir.iterdir()}  # every figure (one run serves the figure-set check too)
+    expected = {"fig8.png", "fig9.png", "results.json"} | {f"fig12_group{g}.png" for g in range(1, 7)} | {
+        f"convergence_group{g}.png" for g in range(1, 7)}
+    assert expected <= names
+    assert not [n for n in names if n.startswith(".")], "temporary files left behind"
+    for name in expected - {"results.json"}:
+        assert (out_dir / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
     d = json.loads((out_dir / "results.json").read_text())
     assert d["settings"]["trials"] == 2 and "compensation_deg_std" in d["groups"][0]
     assert len(d["fig8"]["n"]) == 19
