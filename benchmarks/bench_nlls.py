@@ -14,10 +14,17 @@ Timed per identification (median over passes of the mean over the rounds):
   scipy-lm       scipy.optimize.least_squares(method="lm") on the same whitened,
                  scaled residuals and Jacobian, ordinary callbacks (numpy in,
                  CasADi Function __call__, numpy out), solver call alone
-  scipy-lm-zc    the same with zero-copy callbacks (CasADi buffers)
+  scipy-zc       the same with zero-copy callbacks (CasADi buffers)
   scipy-zc-c     zero-copy callbacks of the compiled Functions (like with like
                  for the compiled tier; an extra column)
   batch          identify_batch over all rounds at once (per identification)
+
+and the ratios (scipy's time over ours, > 1: ours is faster):
+
+  x lm           scipy-lm / identify       (the issue's "speedup")
+  x zc           scipy-zc / identify
+  int x lm       scipy-lm / identify-int
+  x zc-c         scipy-zc-c / identify
 
 and the batched path at scale: N = 10,000 identifications at K = 6 in one
 process (one core).  Ratios are against scipy-lm of the same run; the answers
@@ -27,6 +34,10 @@ With ZEROCAL_COMPILE=never (or no C compiler) the compiled columns are the
 interpreted ones and the header says so.
 
 Usage: python benchmarks/bench_nlls.py [--rounds N] [--repeat R] [--batch N] [--json]
+
+--json prints a list with one entry per K (keys K, identify_ms, scipy_lm_ms,
+speedup and the other columns; load_average); the batch-at-scale run is the
+K = 6 entry's "batch_at_scale".
 """
 import argparse
 import json
@@ -48,11 +59,23 @@ def timed(fn, repeat):
     return statistics.median(out)
 
 
+def positive_int(text):
+    """argparse type: an integer >= 1."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {v}")
+    return v
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--rounds", type=int, default=50, help="simulated rounds per K (default 50)")
-    ap.add_argument("--repeat", type=int, default=5, help="timing passes, median reported (default 5)")
-    ap.add_argument("--batch", type=int, default=10000, help="identifications of the batch-at-scale run")
+    ap.add_argument("--rounds", type=positive_int, default=50, help="simulated rounds per K (default 50)")
+    ap.add_argument("--repeat", type=positive_int, default=5, help="timing passes, median reported (default 5)")
+    ap.add_argument("--batch", type=positive_int, default=10000,
+                    help="identifications of the batch-at-scale run (default 10000)")
     ap.add_argument("--json", action="store_true", help="print a JSON list (one entry per K) instead of text")
     args = ap.parse_args()
 
@@ -124,7 +147,7 @@ def main():
         t = {"identify": timed(run_identify, args.repeat),
              "identify-int": timed(lambda: run_identify("interpreted"), args.repeat),
              "scipy-lm": timed(scipy_runner(False), args.repeat),
-             "scipy-lm-zc": timed(scipy_runner(True), args.repeat),
+             "scipy-zc": timed(scipy_runner(True), args.repeat),
              "scipy-zc-c": timed(scipy_runner(True, "compiled"), args.repeat),
              "batch": timed(run_batch, args.repeat)}
         use("compiled")
@@ -138,10 +161,10 @@ def main():
             "identify_interpreted_ms": 1e3 * t["identify-int"],
             "scipy_lm_zero_copy_compiled_ms": 1e3 * t["scipy-zc-c"],
             "scipy_lm_ms": 1e3 * t["scipy-lm"],
-            "scipy_lm_zero_copy_ms": 1e3 * t["scipy-lm-zc"],
+            "scipy_lm_zero_copy_ms": 1e3 * t["scipy-zc"],
             "batch_ms": 1e3 * t["batch"],
             "speedup": t["scipy-lm"] / t["identify"],
-            "speedup_zero_copy": t["scipy-lm-zc"] / t["identify"],
+            "speedup_zero_copy": t["scipy-zc"] / t["identify"],
             "speedup_interpreted": t["scipy-lm"] / t["identify-int"],
             "speedup_zero_copy_compiled": t["scipy-zc-c"] / t["identify"],
             "max_diff_compiled_deg": float(np.max(np.abs(np.degrees(
@@ -176,18 +199,23 @@ def main():
                           f"batch_success{sfx}": int(b.success.sum())})
         if tier == "compiled":
             scale_run["compiled"] = bool(prob.compiled)
+    load = os.getloadavg()[0]
     if args.json:
-        print(json.dumps(rows + [scale_run], indent=2))
+        for r in rows:
+            r["load_average"] = load
+        next(r for r in rows if r["K"] == 6)["batch_at_scale"] = scale_run
+        print(json.dumps(rows, indent=2))
         return
     mode = "compiled" if all(r["compiled"] for r in rows) else f"NOT compiled ({compiled.status()[-1][2]})"
     print(f"identify and batch on the {mode} tier; identify-int and scipy on the interpreted Functions "
           f"(scipy-zc-c: zero-copy callbacks of the compiled ones)")
-    print(f"{'K':>3s} {'identify ms':>12s} {'identify-int':>12s} {'scipy-lm ms':>12s} {'scipy-zc ms':>12s} "
-          f"{'scipy-zc-c':>11s} {'batch ms':>9s} {'speedup':>8s} {'vs zc':>6s} {'int':>6s} {'vs zc-c':>8s}  answers")
+    print("times in ms per identification; ratios = scipy's time / ours (> 1: ours faster), see --help")
+    print(f"{'K':>3s} {'identify':>12s} {'identify-int':>12s} {'scipy-lm':>12s} {'scipy-zc':>12s} "
+          f"{'scipy-zc-c':>11s} {'batch':>9s} {'x lm':>8s} {'x zc':>6s} {'int x lm':>8s} {'x zc-c':>8s}  answers")
     for r in rows:
         print(f"{r['K']:3d} {r['identify_ms']:12.3f} {r['identify_interpreted_ms']:12.3f} {r['scipy_lm_ms']:12.3f} "
               f"{r['scipy_lm_zero_copy_ms']:12.3f} {r['scipy_lm_zero_copy_compiled_ms']:11.3f} {r['batch_ms']:9.3f} "
-              f"{r['speedup']:8.2f} {r['speedup_zero_copy']:6.2f} {r['speedup_interpreted']:6.2f} "
+              f"{r['speedup']:8.2f} {r['speedup_zero_copy']:6.2f} {r['speedup_interpreted']:8.2f} "
               f"{r['speedup_zero_copy_compiled']:8.2f}  "
               f"same problem: max |ours - scipy| {r['max_diff_to_scipy_deg']:.1e} deg (reweighting moves the "
               f"answer {r['reweighting_effect_deg']:.1e} deg), |batch - single| "
@@ -198,7 +226,7 @@ def main():
           f"{scale_run['batch_total_s']:.2f} s compiled (confirmed {scale_run['batch_confirmed']}, succeeded "
           f"{scale_run['batch_success']}), {scale_run['batch_total_interpreted_s']:.2f} s interpreted (confirmed "
           f"{scale_run['batch_confirmed_interpreted']})")
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    print(f"load average {load:.2f} on {os.cpu_count()} cores")
 
 if __name__ == "__main__":
     main()
