@@ -66,3 +66,11 @@ def test_script_b_prints_the_start_dependence():
     assert worst[0] == pytest.approx(float(m.group(1)), rel=0.05)
     assert worst[1] == pytest.approx(float(m.group(2)), rel=0.05)
     assert worst[3] == worst[1]  # any non-zero reweight is the same
+
+
+def test_script_d_prints_what_the_page_shows():
+    out = _run(_script("D"))
+    text = DOC.read_text()
+    at = text.index("### Batched identification")
+    shown = text[text.index("```\n", at) + 4:text.index("\n```", text.index("```\n", at) + 4)]
+    assert out.strip() == shown.strip()
