@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.nlls import GN_STEP_TOL, identify_nlls, noise_terms
 from zerocal_sym.identify.nlls_problem import GN_BLOCKS, get_problem
@@ -91,30 +92,93 @@ def _gauss_newton_blocks(prob, z, P):
     return z.T, step, r, J
 
 
-def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel | None = None,
+def _indices(idx, limit: int = 10) -> str:
+    """``1, 4, 7`` (at most ``limit`` of them, then how many in all)."""
+    idx = [int(i) for i in idx]
+    more = f", ... ({len(idx)} in all)" if len(idx) > limit else ""
+    return ", ".join(map(str, idx[:limit])) + more
+
+
+def _check_inputs(robot, theta_cmd, readings, names):
+    """``theta_cmd`` (K, m) and ``readings`` (N, K) as float arrays, or the error that says what is wrong where."""
+    m = robot.m
+    th = np.asarray(theta_cmd, float)
+    if th.ndim != 2 or th.shape[1] != m:
+        hint = " (transposed? one row per pose)" if th.ndim == 2 and th.shape[0] == m else ""
+        raise ValueError(f"theta_cmd must have shape (K, m) = (K, {m}), the {m} commanded joint angles of robot "
+                         f"{robot.name!r} at each of the K poses, got {th.shape}{hint}")
+    K = th.shape[0]
+    R = np.asarray(readings, float)
+    given = R.shape
+    if R.ndim == 1:  # one data set
+        R = R[None, :]
+    if R.ndim != 2 or R.shape[1] != K:
+        hint = (" (transposed? one row per data set, one column per pose)"
+                if R.ndim == 2 and R.shape[0] == K else "")
+        raise ValueError(f"readings must have shape (N, K) = (N, {K}) for the {K} poses of theta_cmd (one row per "
+                         f"data set), got {given}{hint}")
+    p = len(names)
+    if K - 1 < p:  # as the CLI: every data set would be rank deficient (no Gaussian prior here to make up for it)
+        raise IdentificationError(f"{K} poses give {K - 1} measured changes: fewer than the {p} parameters "
+                                  f"{', '.join(names)}: every data set would be rank deficient (not identifiable; "
+                                  "the batch takes no Gaussian prior to make up for it)")
+    bad = ~np.isfinite(th)
+    if bad.any():
+        k = np.flatnonzero(bad.any(axis=1))
+        raise ValueError(f"theta_cmd must be finite: NaN or inf joint angles at pose(s) {_indices(k)} "
+                         f"(theta_cmd[{k[0]}] = {th[k[0]].tolist()})")
+    bad = ~np.isfinite(R)
+    if bad.any():
+        rows, poses = np.flatnonzero(bad.any(axis=1)), np.flatnonzero(bad.any(axis=0))
+        i, k = np.argwhere(bad)[0]
+        raise ValueError(f"readings must be finite: {int(bad.sum())} NaN or inf value(s) in data set(s) (row) "
+                         f"{_indices(rows)} at pose(s) (column) {_indices(poses)}; the first: readings[{i}, {k}] "
+                         f"= {R[i, k]}")
+    return th, R
+
+
+def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel | str | None = None,
                    prior=None) -> BatchResult:
     """Identify N data sets measured at the same commanded joints.
 
     Parameters
     ----------
     theta_cmd : ndarray, shape (K, m)
-    readings : ndarray, shape (N, K)
-        ``readings[:, 0] = 0``.
-    params, noise, prior
+        Commanded joint angles, rad.
+    readings : ndarray, shape (N, K), or (K,) for one data set
+        Scale readings, mm, one row per data set.  ``readings[:, 0]`` (the
+        reference pose, 0 by definition) is not used, as in
+        :func:`~zerocal_sym.identify.nlls.identify_nlls`: only the K - 1
+        changes ``readings[:, 1:]`` enter.
+    params, prior
         As :func:`zerocal_sym.identify.nlls.identify_nlls` (no bounds, no Gaussian prior).
+    noise : NoiseModel, str or None
+        As :func:`zerocal_sym.identify.nlls.identify_nlls`: a
+        :class:`~zerocal_sym.model.noise.NoiseModel`, one of the names the
+        CLI's ``--noise`` takes (``paper``, ``scale-only``, ``servo-only``,
+        ``none``: :meth:`NoiseModel.named`) or None (the paper's).
 
     Returns
     -------
     BatchResult
+
+    Raises
+    ------
+    ValueError
+        ``theta_cmd`` or ``readings`` of the wrong shape, or not finite
+        (the message names the data sets (rows) and poses); an unknown
+        parameter or noise name.
+    TypeError
+        ``noise`` neither a NoiseModel, a name nor None.
+    IdentificationError
+        Fewer measured changes (K - 1) than parameters: without a Gaussian
+        prior every data set would be rank deficient (as the CLI refuses).
     """
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise)
     errors = robot.errors
     names = errors.resolve(params)
-    theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
-    readings = np.atleast_2d(np.asarray(readings, float))
+    theta_cmd, readings = _check_inputs(robot, theta_cmd, readings, names)
     N, K = readings.shape
-    if theta_cmd.shape != (K, robot.m):
-        raise ValueError(f"theta_cmd must have shape ({K}, {robot.m}), got {theta_cmd.shape}")
     prior_q = errors.zeros() if prior is None else errors.check_vector(prior, "prior")
     p = len(names)
     scale = fisher.parameter_scale(robot, names)

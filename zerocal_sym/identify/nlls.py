@@ -134,15 +134,21 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     ----------
     robot : Robot
     meas : Measurements
-        ``theta_cmd`` (K, m) rad and ``readings`` (K,) mm (``readings[0] = 0``).
+        ``theta_cmd`` (K, m) rad and ``readings`` (K,) mm, all finite
+        (else :class:`~zerocal_sym.errors.IdentificationError` naming the
+        poses).  ``readings[0]`` (the reference pose, 0 by definition) is
+        not used: only the K - 1 changes ``readings[1:]`` enter.
     params : str or sequence of str
         Parameters to estimate, by name (see :meth:`SourceErrors.resolve`):
         ``"paper"`` (= ``offsets+measuring``: the zero offsets and the MAEMM),
         ``"all"``, ``"offsets+measuring+L1,L2"``, ...
-    noise : NoiseModel, optional
-        Weights and covariance (default: the paper's noise model).  A zero
-        model weights every change equally (1 um) and estimates the
-        covariance from the residuals.
+    noise : NoiseModel or str, optional
+        Weights and covariance (default: the paper's noise model), or the
+        name of one as the CLI's ``--noise`` takes (``paper``,
+        ``scale-only``, ``servo-only``, ``none``:
+        :meth:`NoiseModel.named <zerocal_sym.model.noise.NoiseModel.named>`;
+        anything else: TypeError).  A zero model weights every change
+        equally (1 um) and estimates the covariance from the residuals.
     prior : ndarray, shape (q,), optional
         Current belief about the total source errors (rad, mm): the values
         of the parameters not estimated, the mean of the Gaussian prior of
@@ -208,7 +214,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         residuals"`` (zero noise model).
     """
     t0 = time.perf_counter()
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise)
     if loss not in LOSSES:
         raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     delta = None
@@ -224,12 +230,24 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
     K = theta_cmd.shape[0]
+    src = getattr(meas, "source", None)
     if K < 2:
         raise IdentificationError(f"need at least 2 poses, got {K}")
-    if theta_cmd.shape[1] != robot.m:
-        raise IdentificationError(f"measurements have {theta_cmd.shape[1]} joint angles per pose, the robot "
-                                  f"{robot.name!r} has {robot.m} joints", where=getattr(meas, "source", None))
-    s = np.asarray(meas.readings, float)[1:]
+    if theta_cmd.ndim != 2 or theta_cmd.shape[1] != robot.m:
+        raise IdentificationError(f"theta_cmd must have shape (K, m) = (K, {robot.m}), the {robot.m} commanded "
+                                  f"joint angles of robot {robot.name!r} at each pose, got {theta_cmd.shape}",
+                                  where=src)
+    readings = np.asarray(meas.readings, float)
+    if readings.shape != (K,):
+        raise IdentificationError(f"readings must have shape (K,) = ({K},) for the {K} poses of theta_cmd, got "
+                                  f"{readings.shape}", where=src)
+    for what, a in (("theta_cmd (commanded joint angles)", theta_cmd), ("readings", readings)):
+        bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(K, -1)), axis=1))
+        if bad.size:
+            raise IdentificationError(f"{what} must be finite: NaN or inf at pose(s) "
+                                      f"{', '.join(map(str, bad[:10]))}{', ...' if bad.size > 10 else ''}",
+                                      where=meas.where(int(bad[0])) if getattr(meas, "lines", None) else src)
+    s = readings[1:]
     prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
     scale = fisher.parameter_scale(robot, names)
     if prior_cov is not None:

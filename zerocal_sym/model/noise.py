@@ -20,6 +20,8 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 
+#: the names of :meth:`NoiseModel.named` (the CLI's ``--noise`` choices)
+NOISE_NAMES = ("paper", "scale-only", "servo-only", "none")
 
 
 def paper_sigma_scale_mm(l0_mm: float = 350.0) -> float:
@@ -54,12 +56,41 @@ class NoiseModel:
 
     @classmethod
     def named(cls, name: str) -> "NoiseModel":
-        """``paper`` | ``scale-only`` | ``servo-only`` | ``none``."""
+        """``paper`` | ``scale-only`` | ``servo-only`` | ``none`` (:data:`NOISE_NAMES`)."""
         table = {"paper": cls.paper(), "scale-only": cls.paper(servo=0.0),
                  "servo-only": cls.paper(scale=0.0), "none": cls()}
         if name not in table:
             raise ValueError(f"unknown noise model {name!r} (known: {', '.join(table)})")
         return table[name]
+
+    @classmethod
+    def coerce(cls, noise, what: str = "noise") -> "NoiseModel":
+        """The noise model an identification argument names.
+
+        ``None``: the paper's (:meth:`paper`); a :class:`NoiseModel`: itself;
+        a name (``str``): :meth:`named`, the names the CLI's ``--noise`` and
+        a study spec's ``noise`` list accept.
+
+        Raises
+        ------
+        ValueError
+            An unknown name.
+        TypeError
+            Anything else (a factor of the paper's noise is
+            ``NoiseModel.paper(f, f)``).
+        """
+        if noise is None:
+            return cls.paper()
+        if isinstance(noise, NoiseModel):
+            return noise
+        if isinstance(noise, str):
+            try:
+                return cls.named(noise)
+            except ValueError as exc:
+                raise ValueError(f"{what}: {exc}") from None
+        raise TypeError(f"{what} must be a NoiseModel, one of the names {', '.join(NOISE_NAMES)} or None (the "
+                        f"paper's), got {noise!r} ({type(noise).__name__}); a factor f of the paper's noise is "
+                        "NoiseModel.paper(f, f)")
 
     @property
     def is_zero(self) -> bool:
