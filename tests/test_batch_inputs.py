@@ -155,3 +155,20 @@ def test_the_first_reading_is_not_used(robot, th6, R):
     shifted[:, 0] = [1.0, -3.0]
     np.testing.assert_array_equal(identify_batch(robot, th6, shifted).estimate,
                                   identify_batch(robot, th6, R[:2]).estimate)
+
+
+def test_nonfinite_fail_leaves_those_data_sets_failed_and_the_rest_unchanged(robot, th6, R):
+    """Monte Carlo callers (a simulated pose the robot cannot reach reads NaN) count such data sets as failed."""
+    Rb = R.copy()
+    Rb[[1, 3], 2] = np.nan
+    full = identify_batch(robot, th6, R, noise="paper")
+    b = identify_batch(robot, th6, Rb, noise="paper", nonfinite="fail")
+    keep = np.array([i not in (1, 3) for i in range(len(R))])
+    assert not b.success[~keep].any() and not b.confirmed[~keep].any() and np.isnan(b.estimate[~keep]).all()
+    np.testing.assert_array_equal(b.estimate[keep], full.estimate[keep])
+    np.testing.assert_array_equal(b.p_value[keep], full.p_value[keep])
+    assert b.success[keep].all() and b.dof == full.dof
+    allbad = identify_batch(robot, th6, np.full_like(R, np.nan), noise="paper", nonfinite="fail")
+    assert allbad.estimate.shape == R.shape[:1] + (4,) and not allbad.success.any()
+    with pytest.raises(ValueError, match="nonfinite must be"):
+        identify_batch(robot, th6, R, noise="paper", nonfinite="skip")

@@ -138,7 +138,7 @@ def _check_inputs(robot, theta_cmd, readings, names):
 
 
 def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel | str | None = None,
-                   prior=None) -> BatchResult:
+                   prior=None, nonfinite: str = "raise") -> BatchResult:
     """Identify N data sets measured at the same commanded joints.
 
     Parameters
@@ -157,6 +157,11 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
         :class:`~zerocal_sym.model.noise.NoiseModel`, one of the names the
         CLI's ``--noise`` takes (``paper``, ``scale-only``, ``servo-only``,
         ``none``: :meth:`NoiseModel.named`) or None (the paper's).
+    nonfinite : {"raise", "fail"}
+        Readings with NaN or inf: a ``ValueError`` naming them (default), or
+        (``"fail"``, for simulations: a pose the simulated robot cannot reach
+        reads NaN) those data sets are not identified and count as failed
+        (``success`` and ``confirmed`` False, NaN estimates).
 
     Returns
     -------
@@ -177,6 +182,20 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
     noise = NoiseModel.coerce(noise)
     errors = robot.errors
     names = errors.resolve(params)
+    if nonfinite not in ("raise", "fail"):
+        raise ValueError(f"nonfinite must be 'raise' or 'fail', got {nonfinite!r}")
+    if nonfinite == "fail":
+        R = np.asarray(readings, float)
+        keep = np.isfinite(R).all(axis=-1) if R.ndim == 2 else None
+        if keep is not None and not keep.all():  # identify the others; the non-finite rows failed
+            sub = identify_batch(robot, theta_cmd, R[keep], params, noise, prior)
+            est = np.full((R.shape[0], len(names)), np.nan)
+            std, chi2, pv = est.copy(), np.full(R.shape[0], np.nan), np.full(R.shape[0], np.nan)
+            success, confirmed = np.zeros(R.shape[0], bool), np.zeros(R.shape[0], bool)
+            est[keep], std[keep], chi2[keep], pv[keep] = sub.estimate, sub.std, sub.chi2, sub.p_value
+            success[keep], confirmed[keep] = sub.success, sub.confirmed
+            return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed,
+                               chi2=chi2, dof=sub.dof, p_value=pv)
     theta_cmd, readings = _check_inputs(robot, theta_cmd, readings, names)
     N, K = readings.shape
     prior_q = errors.zeros() if prior is None else errors.check_vector(prior, "prior")

@@ -250,7 +250,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
                 ip_t.append(ref.info["time_s"])
     if "nlls" in methods:  # the one-shot Ipopt of all first rounds in one batch (unconfirmed: the single path)
         t = time.perf_counter()
-        b = identify_batch(robot, th0, np.array(first), names, noise=noise)
+        b = identify_batch(robot, th0, np.array(first), names, noise=noise, nonfinite="fail")
         dt = (time.perf_counter() - t) / len(first)
         for k in range(len(first)):
             record("nlls", b.values(paper4)[k] if b.success[k] else None, dt)

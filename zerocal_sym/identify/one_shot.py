@@ -69,7 +69,7 @@ def one_shot_chunk(task: OneShotTask) -> dict:
     plant = VirtualPlant(task.robot, task.err)
     R = simulate_readings(task.robot, plant, task.theta, task.noise, task.seed, task.stream, task.start, task.stop)
     t = time.perf_counter()
-    b = identify_batch(task.robot, task.theta, R, task.params, noise=task.noise)
+    b = identify_batch(task.robot, task.theta, R, task.params, noise=task.noise, nonfinite="fail")
     return {"trial": np.arange(task.start, task.stop, dtype=np.int64), "estimate": b.estimate, "std": b.std,
             "chi2": b.chi2, "success": b.success, "confirmed": b.confirmed,
             "time_s": time.perf_counter() - t}
