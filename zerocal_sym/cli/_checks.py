@@ -117,6 +117,41 @@ def _outputs(args, outputs, inputs) -> None:
     check_outputs(outputs, list(inputs) + [("the robot file", robot)])
 
 
+def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
+    """Why the parameters ``names`` cannot be identified from the poses ``theta_cmd`` (a phrase), or None.
+
+    Too few measured changes, or the rank of the sensitivity of the K-1
+    changes to the parameters at ``err0``
+    (:func:`~zerocal_sym.identify.identifiability.identifiability_report`)
+    below p; where the mechanism's gauge motions span the null space, says
+    which, and which gauge-fixing parameters to leave out.  ``poses``: how the
+    phrase names the poses (default ``these K poses``).
+    """
+    from zerocal_sym.identify.identifiability import identifiability_report
+
+    names = list(names)
+    K, p = len(theta_cmd), len(names)
+    poses = poses or f"these {K} poses"
+    if K - 1 < p:
+        return f"{poses} give {K - 1} measured changes, fewer than the {p} parameters"
+    rep = identifiability_report(robot, theta_cmd, names, err0=err0)
+    r = rep["rank"]
+    if r >= p:
+        return None
+    if rep["null_space_rigid"]:
+        motions = [lab for labs in rep["null_space_gauge"] for lab in labs]
+        fix = [n for n in rep["gauge_fix"] if n in names]
+        why = (f"the distances do not see the rigid motion{'s' if len(motions) > 1 else ''} {', '.join(motions)}"
+               + (f"; leave {', '.join(fix)} out of the parameters to fix {'them' if len(motions) > 1 else 'it'}"
+                  if fix else ""))
+    else:
+        bad = [n for n, ok in rep["identifiable"].items() if not ok]
+        why = (f"{p - r} unobservable combination{'s' if p - r > 1 else ''} of "
+               + ", ".join(bad[:6]) + (f" and {len(bad) - 6} more" if len(bad) > 6 else "")
+               + "; identify fewer parameters or measure other poses")
+    return f"the {p} parameters are not identifiable from {poses} (rank {r} of {p}: {why})"
+
+
 # --------------------------------------------------------------------------- per command
 
 def _trust(args) -> None:

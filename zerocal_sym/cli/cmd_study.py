@@ -9,8 +9,11 @@ one-shot Ipopt identifications in chunks; each chunk is written atomically to
 ``OUT/<cell-id>/chunk-<k>.npz``.  A rerun skips the chunks on disk (it says
 how many), so an interrupted study resumes.  At the end the summary (per cell
 and parameter: bias, RMS, CRLB, RMS/CRLB, 5 % / median / 95 % of the errors)
-is printed and written to ``OUT/summary.json``; ``--summary DIR`` prints it
-from the chunk files without running anything.
+is printed and written to ``OUT/summary.json`` (a run with work to do first
+removes the old one); ``--summary DIR`` prints it from the chunk files without
+running anything.  A damaged chunk file or another cell's, and a directory
+that holds another study, are refused before any work (one line naming it;
+delete a refused chunk file to have it recomputed).
 
 Examples:
 
@@ -23,9 +26,32 @@ NAME = "study"
 HELP = "a Monte Carlo study over robots, designs, noise levels and truths (chunked, resumable)"
 
 
+def _hide_robot(p):
+    """Take the shared ``--robot`` out of study's help (a study's robots are in its spec).
+
+    The option stays accepted, hidden, so that giving it is the one-line error
+    that says where the robots go (``_checks._study``).  The action is the
+    parent parser's, shared by every command: study gets a hidden copy.
+    """
+    import argparse
+    import copy
+
+    for a in list(p._actions):
+        if "--robot" in a.option_strings:
+            hidden = copy.copy(a)
+            hidden.help = argparse.SUPPRESS
+            p._actions[p._actions.index(a)] = hidden
+            for g in p._action_groups:
+                if a in g._group_actions:
+                    g._group_actions[g._group_actions.index(a)] = hidden
+            for s in a.option_strings:
+                p._option_string_actions[s] = hidden
+
+
 def add_arguments(p):
     from zerocal_sym.cli import _parallel
 
+    _hide_robot(p)
     p.add_argument("spec", metavar="SPEC.toml", help="the study spec")
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--out", metavar="DIR", help="run the study into DIR (resumes what is there)")
@@ -45,7 +71,7 @@ def run(args):
     from zerocal_sym.identify.progress import Progress
     from zerocal_sym.io.files import to_json
 
-    if args.robot:
+    if getattr(args, "robot", None):
         raise ZerocalError("--robot: a study's robots are listed in its spec (robots = [...])")
     spec = load_spec(args.spec)
     if args.summary is not None:

@@ -8,14 +8,20 @@ exact model, :func:`~zerocal_sym.identify.batch.identify_batch`), split in
 chunks of consecutive trials, each written atomically to its own file
 (:mod:`zerocal_sym.cli.study_chunks`).
 
-A rerun skips the chunks already on disk (a chunk whose trials are not the
-expected ones, e.g. after ``trials`` changed, is recomputed), so an
-interrupted study resumes where it stopped; ``OUT/<cell-id>/cell.json``
-records the cell's settings, and a rerun whose settings differ (other than
-``trials``) is refused.  The summary (:func:`summarize`) is merged from the
-chunk files: per cell and parameter the bias, RMS, sample std, the CRLB at
-the truth and RMS/CRLB, quantiles (5 %, median, 95 %) of the errors, the
-mean reported std, failures.
+A rerun skips the chunks already on disk (the last chunk of a cell whose
+trials stop elsewhere, after ``trials`` changed, is recomputed), so an
+interrupted study resumes where it stopped.  ``OUT/<cell-id>/cell.json``
+records the cell's settings and the study's name: a rerun whose settings
+differ (other than ``trials``) is refused, and so is a directory that holds
+another study (another name; with ``--out``, cells the spec does not have).
+Every chunk file records its cell (id and settings hash): a damaged file or
+another cell's is refused, naming it, before any work (delete it to have it
+recomputed).  A run that has chunks to compute first removes
+``OUT/summary.json`` (it would no longer describe the directory) and writes it
+again at the end.  The summary (:func:`summarize`) is merged from the chunk
+files: per cell and parameter the bias, RMS, sample std, the CRLB at the
+truth and RMS/CRLB, quantiles (5 %, median, 95 %) of the errors, the mean
+reported std, failures.
 
 This module holds the runner (:func:`plan`, :func:`run_study`) and the
 summary (:func:`summarize`, :func:`format_summary`); the spec is read by
@@ -32,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.cli.study_chunks import _cell_json, chunk_path, read_chunk, write_chunk
+from zerocal_sym.cli.study_chunks import ChunkError, _cell_json, check_directory, chunk_path, read_chunk, write_chunk
 from zerocal_sym.cli.study_spec import Study, load_spec  # noqa: F401 - load_spec kept importable from here (benchmarks)
 from zerocal_sym.identify.one_shot import OneShotTask, one_shot_chunk
 from zerocal_sym.identify.parallel import chunk_ranges, describe_scheduler, run_chunks
@@ -42,15 +48,33 @@ from zerocal_sym.identify.stats import QUANTILES, Stats
 # --------------------------------------------------------------------------- running
 
 def plan(study: Study, out) -> tuple:
-    """``(todo, on_disk)``: the chunks to run ``[(cell, k, start, stop)]`` and how many are already done."""
-    todo, done = [], 0
+    """``(todo, on_disk)``: the chunks to run ``[(cell, k, start, stop)]`` and how many are already done.
+
+    Every chunk file on disk is read (:func:`~zerocal_sym.cli.study_chunks.read_chunk`).
+
+    Raises
+    ------
+    ChunkError
+        The first chunk file that is refused (damaged, another cell's), with the number of others.
+    """
+    todo, done, bad = [], 0, []
     for cell in study.cells:
+        digest = cell.digest(study)
         for k, (a, b) in enumerate(chunk_ranges(study.trials, study.chunk)):
             p = chunk_path(out, cell, k)
-            if p.exists() and read_chunk(p, cell.params, a, b, columns=False) is not None:
+            try:
+                ok = p.exists() and read_chunk(p, cell.id, digest, cell.params, a, b, columns=False) is not None
+            except ChunkError as exc:
+                bad.append(exc)
+                continue
+            if ok:
                 done += 1
             else:
                 todo.append((cell, k, a, b))
+    if bad:
+        n = len(bad) - 1
+        more = f" ({n} other chunk file{'s are' if n > 1 else ' is'} refused too)" if n else ""
+        raise ChunkError(bad[0].message + more, where=bad[0].where)
     return todo, done
 
 
@@ -66,7 +90,8 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     progress : callable, optional
         ``progress(done)`` with the trials done in this run.  A ``KeyboardInterrupt``
         (Ctrl-C, or raised by it) stops the run: the chunks written so far stay
-        (complete files), nothing partial is left, no summary is written.
+        (complete files), nothing partial is left, no summary is written (and the
+        one of an earlier run is gone: it was removed when this run started work).
     log : callable, optional
         ``log(text)`` for the one-line account of what is on disk and what runs.
     make_progress : callable, optional
@@ -76,12 +101,18 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     -------
     dict
         The summary (:func:`summarize`), also written to ``OUT/summary.json``.
+
+    Raises
+    ------
+    ZerocalError
+        Before anything is written: ``out`` holds another study
+        (:func:`~zerocal_sym.cli.study_chunks.check_directory`), a cell's
+        cell.json other settings, a chunk file is refused (:func:`plan`).
     """
     from zerocal_sym.io.files import write_json
 
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ZerocalError("the study output must be a directory", where=str(out))
+    check_directory(out, study, run=True)
     for cell in study.cells:
         _cell_json(out, cell, study, check_only=True)
     todo, on_disk = plan(study, out)
@@ -93,14 +124,17 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     if make_progress is not None:
         progress = make_progress(sum(b - a for *_, a, b in todo))
     t0 = time.perf_counter()
+    if todo:  # the summary of an earlier run no longer describes the directory: gone before the first chunk
+        (out / "summary.json").unlink(missing_ok=True)
     for cell in {c.id: c for c, *_ in todo}.values():
         _cell_json(out, cell, study)
+    digests = {c.id: c.digest(study) for c, *_ in todo}
     tasks = [OneShotTask(c.robot, c.theta, c.truth, c.noise, c.params, study.seed, c.stream, a, b)
              for c, k, a, b in todo]
 
     def save(i, cols):
         cell, k, a, b = todo[i]
-        write_chunk(chunk_path(out, cell, k), cols, cell.params)
+        write_chunk(chunk_path(out, cell, k), cols, cell.params, cell.id, digests[cell.id])
         return float(cols.get("time_s", 0.0))
 
     times = run_chunks(one_shot_chunk, tasks, [b - a for *_, a, b in todo], workers, scheduler, progress,
@@ -132,12 +166,21 @@ def _crlb(cell):
 def summarize(study: Study, out) -> dict:
     """Merge the chunk files on disk into per-cell statistics (errors in deg for angles, mm otherwise).
 
-    Cells with missing chunks are summarised over what is there (``trials_done``).
+    Cells with missing chunks are summarised over what is there (``trials_done``); the last chunk of a
+    cell whose trials stop elsewhere (``trials`` changed) is left out.
+
+    Raises
+    ------
+    ZerocalError
+        ``out`` holds another study (another name), a cell's cell.json other settings, a chunk file is
+        refused (:func:`~zerocal_sym.cli.study_chunks.read_chunk`).
     """
     out = Path(out)
+    check_directory(out, study, run=False)
     cells = []
     for cell in study.cells:
         _cell_json(out, cell, study, check_only=True)  # chunks of other settings are not merged
+        digest = cell.digest(study)
         errors = cell.robot.errors
         names = cell.params
         conv = np.array([math.degrees(1.0) if errors[n].unit == "rad" else 1.0 for n in names])
@@ -147,7 +190,7 @@ def summarize(study: Study, out) -> dict:
         chi2_sum, t_id = 0.0, 0.0
         for k, (a, b) in enumerate(chunk_ranges(study.trials, study.chunk)):
             p = chunk_path(out, cell, k)
-            cols = read_chunk(p, names, a, b) if p.exists() else None
+            cols = read_chunk(p, cell.id, digest, names, a, b) if p.exists() else None
             if cols is None:
                 continue
             chunks += 1

@@ -30,7 +30,9 @@ Spec (paths relative to the spec file; angles in degrees, lengths in mm)::
     theta2 = -1
     theta3 = 0.5
 
-Errors in the spec are one line naming the file and the line.
+Errors in the spec are one line naming the file and the line; among them a
+parameter set that a design's poses cannot identify (rank of the sensitivity
+below the number of parameters, :func:`~zerocal_sym.cli._checks.identifiability_problem`).
 """
 from __future__ import annotations
 
@@ -91,6 +93,13 @@ class Cell:
                       "units": {k: r.errors[k].user_unit for k in self.truth_user}},
             "params": list(self.params), "seed": study.seed, "stream": self.stream, "chunk": study.chunk,
         })
+
+    def digest(self, study) -> str:
+        """SHA-256 of :meth:`settings` (canonical JSON): recorded in each chunk file of the cell."""
+        import json
+
+        text = json.dumps(self.settings(study), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
 
 
 @dataclass
@@ -259,6 +268,7 @@ def load_spec(path) -> Study:
     StudySpecError
         Naming the spec file and the line.
     """
+    from zerocal_sym.cli._checks import identifiability_problem
     from zerocal_sym.cli._common import parse_named_values
     from zerocal_sym.model import kinematics as kin
 
@@ -341,6 +351,11 @@ def load_spec(path) -> Study:
                 if not isinstance(tlabel, str) or not tlabel:
                     raise StudySpecError("name must be a non-empty string", where=wt("name"))
                 values = {k: v for k, v in tt.items() if k not in TRUTH_RESERVED}
+                for k in values:
+                    if k not in robot.errors.names:
+                        raise StudySpecError(f"robot {rl!r}: unknown source error {k!r} in [[truth]] (mechanism "
+                                             f"{robot.mechanism_name}: {', '.join(robot.errors.names)}; and the "
+                                             f"table's keys {', '.join(TRUTH_RESERVED)})", where=wt(k))
                 for k, v in values.items():
                     if not _is_num(v):
                         raise StudySpecError(f"{k} = {v!r}: expected a finite number (deg for angles, mm otherwise)",
@@ -350,6 +365,11 @@ def load_spec(path) -> Study:
                 except ZerocalError as exc:
                     bad = next((k for k in values if k not in robot.errors.names), None)
                     raise StudySpecError(f"robot {rl!r}: {exc.message}", where=wt(bad)) from None
+                truth = robot.errors.from_user(user)
+                problem = identifiability_problem(robot, theta, names, err0=truth)
+                if problem:
+                    raise StudySpecError(f"robot {rl!r}, design {dlabel}: params = {params!r}: {problem}",
+                                         where=wd(None))
                 for nl, noise in noises:
                     cid = "_".join(_slug(x) for x in (rl, dlabel, nl, tlabel))
                     stream = 0 if streams == "common" else int.from_bytes(
@@ -358,7 +378,7 @@ def load_spec(path) -> Study:
                         raise StudySpecError(f"two cells named {cid!r}: give the [[design]]/[[truth]] tables "
                                              "distinct labels/names", where=wt("name") if "name" in tt else wd(None))
                     study.cells.append(Cell(cid, robot, rl, dlabel, P, theta, nl, noise, tlabel,
-                                            robot.errors.from_user(user), user, names, stream))
+                                            truth.copy(), user, names, stream))
     if not study.cells:
         raise StudySpecError("no cell: every [[design]] or [[truth]] is filtered out for every robot",
                              where=str(path))
