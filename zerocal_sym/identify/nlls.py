@@ -14,8 +14,9 @@ Weighting (errors-in-variables, marginalised to first order)
     ``C = Cov(s) = sigma_m^2 I + D diag(sigma_xi^2 |d rho/d theta|^2) D^T``
     (:func:`zerocal_sym.identify.fisher.measurement_covariance`; consecutive changes
     are correlated because they share a pose).  The residuals are whitened by
-    the inverse Cholesky factor of ``C``, evaluated at the initial point and
-    re-evaluated once at the solution (``reweight=1``), so the cost is
+    the inverse Cholesky factor of ``C``, re-evaluated at every Gauss-Newton
+    iterate (``reweight=1``: the answer is the weights' fixed point; 0 holds
+    them at the start), so the cost is
     ``0.5 |L^-1 (s - s(p))|^2`` (+ prior terms): a Gaussian negative
     log-likelihood whose Gauss-Newton Hessian is the Fisher information used
     by :mod:`zerocal_sym.identify.fisher`.
@@ -41,13 +42,15 @@ Priors and bounds
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 import numpy as np
 
 from zerocal_sym.identify import fisher, fitcheck
 from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear
-from zerocal_sym.errors import IdentificationError
 from zerocal_sym.model.noise import NoiseModel
+from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, initial, prior_whitener,
+                                             scaled_bounds)
 from zerocal_sym.identify.nlls_problem import get_problem
 from zerocal_sym.model.fastcall import FastCall
 from zerocal_sym.identify.result import IdentificationResult
@@ -64,64 +67,11 @@ GN_STEP_TOL = 1e-8
 LOSSES = ("l2", "huber", "soft_l1")
 
 
-def _as_vector(x, n, what):
-    a = np.asarray(x, float).ravel()
-    if a.shape != (n,):
-        raise ValueError(f"{what}: expected {n} values, got {a.size}")
-    return a
-
-
 def noise_terms(noise: NoiseModel):
     """``(sigma_m^2, sigma_xi^2)`` of the whitening; a zero model weights every change by 1 um."""
     if noise.is_zero:
         return UNIT_SIGMA_MM**2, 0.0
     return float(noise.sigma_scale_mm) ** 2, float(noise.sigma_servo_rad) ** 2
-
-
-def _bounds(bounds, names, scale):
-    n = len(names)
-    lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
-    if bounds is None:
-        return lo, hi
-    if isinstance(bounds, dict):
-        for k, (a, b) in bounds.items():
-            if k not in names:
-                raise ValueError(f"bounds given for {k!r}, which is not estimated ({', '.join(names)})")
-            lo[names.index(k)], hi[names.index(k)] = a, b
-    else:
-        b = np.asarray(bounds, float)
-        if b.shape != (n, 2):
-            raise ValueError(f"bounds: expected shape ({n}, 2), got {b.shape}")
-        lo, hi = b[:, 0].copy(), b[:, 1].copy()
-    if np.any(lo > hi):
-        raise ValueError("bounds: lower bound above upper bound")
-    return lo * scale, hi * scale
-
-
-def _initial(robot, meas, names, prior_q, warm_start, prior_values):
-    """Initial guess (physical units, shape (p,)) and a note on where it came from.
-
-    ``prior_values``: ``prior_q`` at ``names`` (the start without a warm start).
-    """
-    x0 = np.array(prior_values, float)
-    if warm_start is None:
-        return x0, "prior"
-    if isinstance(warm_start, str):
-        if warm_start != "tsvd":
-            raise ValueError(f"warm_start must be 'tsvd', None or an array, got {warm_start!r}")
-        try:
-            from zerocal_sym.identify.tsvd import identify_tsvd
-        except ImportError:
-            return x0, "prior (tsvd unavailable)"
-        try:
-            ts = identify_tsvd(robot, meas, prior=prior_q, diagnostics=False)  # the estimate alone
-        except Exception as exc:  # noqa: BLE001 - a failed warm start is not fatal
-            return x0, f"prior (tsvd failed: {exc})"
-        for k, n in enumerate(names):
-            if n in ts.params and np.isfinite(ts.value(n)):
-                x0[k] = ts.value(n)
-        return x0, "tsvd"
-    return _as_vector(warm_start, len(names), "warm_start"), "given"
 
 
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
@@ -228,65 +178,101 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             raise ValueError("a robust loss does not take bounds")
     errors = robot.errors
     names = errors.resolve(params)
-    theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
+    theta_cmd, readings = check_measurements(robot, meas)
     K = theta_cmd.shape[0]
-    src = getattr(meas, "source", None)
-    if K < 2:
-        raise IdentificationError(f"need at least 2 poses, got {K}")
-    if theta_cmd.ndim != 2 or theta_cmd.shape[1] != robot.m:
-        raise IdentificationError(f"theta_cmd must have shape (K, m) = (K, {robot.m}), the {robot.m} commanded "
-                                  f"joint angles of robot {robot.name!r} at each pose, got {theta_cmd.shape}",
-                                  where=src)
-    readings = np.asarray(meas.readings, float)
-    if readings.shape != (K,):
-        raise IdentificationError(f"readings must have shape (K,) = ({K},) for the {K} poses of theta_cmd, got "
-                                  f"{readings.shape}", where=src)
-    for what, a in (("theta_cmd (commanded joint angles)", theta_cmd), ("readings", readings)):
-        bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(K, -1)), axis=1))
-        if bad.size:
-            raise IdentificationError(f"{what} must be finite: NaN or inf at pose(s) "
-                                      f"{', '.join(map(str, bad[:10]))}{', ...' if bad.size > 10 else ''}",
-                                      where=meas.where(int(bad[0])) if getattr(meas, "lines", None) else src)
     s = readings[1:]
     prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
     scale = fisher.parameter_scale(robot, names)
-    if prior_cov is not None:
-        if prior_std is not None:
-            raise ValueError("give prior_std or prior_cov, not both")
-        pc = np.asarray(prior_cov, float)
-        if pc.shape != (len(names), len(names)):
-            raise ValueError(f"prior_cov: expected shape ({len(names)}, {len(names)}), got {pc.shape}")
-        try:
-            w = fisher.whitener(pc)
-        except np.linalg.LinAlgError:
-            raise ValueError("prior_cov must be symmetric positive definite") from None
-    elif prior_std is None:
-        w = np.zeros((len(names), len(names)))
-    else:
-        if isinstance(prior_std, dict):
-            std = np.full(len(names), np.inf)
-            for k, v in prior_std.items():
-                std[names.index(k)] = v
-        else:
-            std = _as_vector(prior_std, len(names), "prior_std")
-        if np.any(std <= 0):
-            raise ValueError("prior_std must be positive (inf for no prior)")
-        w = np.diag(1.0 / std)
+    w = prior_whitener(names, prior_std, prior_cov)
     prob = get_problem(robot, K, names)
     prob.touch()
     mu = errors.take(prior_q, names)
     has_prior = bool(w.any())
-    lbx, ubx = _bounds(bounds, list(names), scale)
-    x0, start = _initial(robot, meas, names, prior_q, warm_start, mu)
+    lbx, ubx = scaled_bounds(bounds, list(names), scale)
+    x0, start = initial(robot, meas, names, prior_q, warm_start, mu)
     z0 = x0 * scale if bounds is None else np.clip(x0 * scale, lbx, ubx)  # (clipping to +-inf: no-op)
-
-    solver = prob.solver_for(max_iter)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
+    sol = _solve(prob, z0, par, reweight, bounds is not None, lbx, ubx, max_iter, K)
+    robust = A = None
+    if loss != "l2":
+        robust, A = _robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w,
+                                  mu * scale, K)
+    r, rp, J, pred, l, b = sol.r, sol.rp, sol.J, sol.pred, sol.l, sol.b
+    Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
+    svd, sv, rank, cov, nonid, offsets_ok = _information(J, Jd, r, K, has_prior, noise, scale, names, errors)
+    success = sol.converged and offsets_ok
+    info = {
+        "solver_status": sol.ret,
+        "iterations": sol.iterations,
+        "cost": 0.5 * float(r @ r + rp @ rp),
+        "chi2": float(r @ r),
+        "dof": (K - 1) - len(names),
+        "time_s": None,
+        "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
+                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"),
+        "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
+        "warm_start": start,
+        "gauss_newton": {"converged": sol.gn_ok, "last_step_mm": sol.step},
+        "initial": x0.tolist(),
+        "rank": rank,
+        "singular_values": sv.tolist(),
+        "nonidentifiable": nonid,
+        "scale_mm_per_unit": scale.tolist(),
+        "prior": prior_q.tolist(),
+        "loss": loss,
+    }
+    if has_prior:
+        info["prior_whitener"] = w.tolist()
+    res = IdentificationResult(method="nlls", params=names, estimate=sol.z / scale,
+                               covariance=cov, success=bool(success),
+                               status=_status(sol, offsets_ok, rank, names, robust, loss),
+                               residuals=np.asarray(s - pred), info=info, errors=errors,
+                               std_kind="from residuals" if noise.is_zero else "total")
+    # the fit check: whitened exact-model residuals at the estimate against the noise model
+    rows = np.flatnonzero(np.any(w != 0, axis=1))
+    if robust is None:
+        terms = None
+        if not rows.size and rank == len(names) and "fit_terms" in prob.fast:  # the per-reading terms, O(K p)
+            terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]
+        lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
+                      np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
+                      None, np.arange(1, K), s - pred, np.eye(len(names)),
+                      scale, names, len(rows), band=(l, b),
+                      svd=None if rows.size else svd,  # no prior rows: J's SVD is Jd's
+                      terms=terms)
+        at = "estimate"
+    else:
+        lin = rb.robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
+        at = ("estimate, without the readings the robust loss down-weighted (at pose "
+              f"{', '.join(map(str, robust['excluded_readings']))})" if robust["excluded_readings"] else "estimate")
+        info["robust"] = {k: v for k, v in robust.items() if not k.startswith("_")}
+    z = sol.z
+    tol_b = 1e-7 * (1.0 + np.abs(z))
+    active = [] if bounds is None else [n for n, zz, lo, hi, tb in zip(names, z, lbx, ubx, tol_b)
+                                        if zz <= lo + tb or zz >= hi - tb]
+    fitcheck.check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
+                          prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
+    info["time_s"] = time.perf_counter() - t0
+    return res
+
+
+def _solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleNamespace:
+    """Gauss-Newton in one CasADi call, then Ipopt from its point: Ipopt's status decides.
+
+    If Gauss-Newton did not converge (or left the bounds) Ipopt starts at
+    ``z0`` and, with ``reweight``, solves once more with the weights at its
+    solution.  Returns ``z`` (p,), ``ret`` (Ipopt's status), ``converged``,
+    ``iterations`` (Ipopt's), ``gn_ok``, ``step`` (Gauss-Newton's last, mm)
+    and, at the final point, the weights ``l`` (K-1,), ``b`` (K-2,), the
+    whitened residuals ``r`` (K-1,) and prior residuals ``rp``, the Jacobian
+    ``J`` (K-1 + p, p) and the predicted changes ``pred`` (K-1,).
+    """
+    solver = prob.solver_for(max_iter)
     fast = prob.fast
     z_gn, step, r, rp, J, pred, l, b = prob.run_gauss_newton(z0, par, bool(reweight), GN_STEP_TOL)
     step = float(step[0])
     gn_ok = bool(np.isfinite(z_gn).all() and step < GN_STEP_TOL
-                 and (bounds is None or (np.all(z_gn >= lbx) and np.all(z_gn <= ubx))))
+                 and (not bounded or (np.all(z_gn >= lbx) and np.all(z_gn <= ubx))))
     if gn_ok:  # Ipopt confirms the Gauss-Newton point (weights at that point)
         z, passes = z_gn, 1
     else:      # Ipopt from the start; with reweight once more with the weights at its solution
@@ -306,37 +292,53 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         if str(stats.get("return_status")) not in CONVERGED_STATUSES:
             break
     ret = str(stats.get("return_status", "unknown"))
-    converged = ret in CONVERGED_STATUSES and bool(np.isfinite(z).all())
-    p_hat = z / scale
     if not gn_ok or moved:  # residuals and Jacobian at the final point (else Gauss-Newton's are current)
         l, b = (np.array(o) for o in fast["weights"](z if reweight else z0, par))
         r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
-    r, rp, pred = r.ravel(), rp.ravel(), pred.ravel()
-    robust = None
-    if loss != "l2":  # from the l2 solution, or from the prior when Ipopt failed (an outlier can cause that)
-        z_start = z if (converged and np.all(np.isfinite(z))) else mu * scale
-        z, robust, ok = rb.robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta,
-                                        w, K)
-        robust["l2_solver_status"] = ret
-        if not ok:
-            converged, ret = False, "robust iteration did not converge"
-        elif not converged:
-            converged, ret = True, f"robust iteration converged; the l2 Ipopt solve: {ret}"
-        p_hat = z / scale
-        l, b = (np.array(o) for o in fast["weights"](z, par))
-        r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
-        r, rp, pred = r.ravel(), rp.ravel(), pred.ravel()
-        A = -(np.diag(l.ravel()) + np.diag(np.ravel(b), -1)) @ J[: K - 1]   # d pred / d z
-        excl = np.asarray(robust["excluded_readings"], int) - 1
-        if robust["refit_without_outliers"]:  # information of the readings kept
-            keep = np.setdiff1d(np.arange(K - 1), excl)
-            Jk = np.zeros((K - 1, len(names)))
-            Jk[: keep.size] = np.linalg.solve(np.linalg.cholesky(robust["_C"][np.ix_(keep, keep)]), -A[keep])
-        else:  # information with the final robust weights: the data rows whitened by chol(C_w)
-            Jk = np.linalg.solve(np.linalg.cholesky(robust["_C_w"]), -A)
-        J = np.vstack([Jk, J[K - 1:]])
-    Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
-    # F = J^T J (data + prior information, scaled units) from one SVD of J: F = V diag(sJ^2) V^T
+    return SimpleNamespace(z=z, ret=ret, converged=ret in CONVERGED_STATUSES and bool(np.isfinite(z).all()),
+                           iterations=total_iter, gn_ok=gn_ok, step=step, l=l, b=b, r=r.ravel(), rp=rp.ravel(),
+                           J=J, pred=pred.ravel())
+
+
+def _robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w, z_prior, K):
+    """The robust loss from the l2 solution ``sol`` (or from the prior when Ipopt failed: an outlier can
+    cause that); updates ``sol`` in place (point, status, weights, residuals, and ``J`` to the information of
+    the readings kept or with the final robust weights).  Returns ``(robust, A)``: the robust stage's record
+    and ``d pred / d z`` (K-1, p)."""
+    from zerocal_sym.identify import robust as rb
+
+    fast = prob.fast
+    z_start = sol.z if (sol.converged and np.all(np.isfinite(sol.z))) else z_prior
+    z, robust, ok = rb.robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta, w, K)
+    robust["l2_solver_status"] = sol.ret
+    if not ok:
+        sol.converged, sol.ret = False, "robust iteration did not converge"
+    elif not sol.converged:
+        sol.converged, sol.ret = True, f"robust iteration converged; the l2 Ipopt solve: {sol.ret}"
+    sol.z = z
+    l, b = (np.array(o) for o in fast["weights"](z, par))
+    r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
+    A = -(np.diag(l.ravel()) + np.diag(np.ravel(b), -1)) @ J[: K - 1]   # d pred / d z
+    excl = np.asarray(robust["excluded_readings"], int) - 1
+    if robust["refit_without_outliers"]:  # information of the readings kept
+        keep = np.setdiff1d(np.arange(K - 1), excl)
+        Jk = np.zeros((K - 1, len(names)))
+        Jk[: keep.size] = np.linalg.solve(np.linalg.cholesky(robust["_C"][np.ix_(keep, keep)]), -A[keep])
+    else:  # information with the final robust weights: the data rows whitened by chol(C_w)
+        Jk = np.linalg.solve(np.linalg.cholesky(robust["_C_w"]), -A)
+    sol.l, sol.b, sol.r, sol.rp, sol.pred = l, b, r.ravel(), rp.ravel(), pred.ravel()
+    sol.J = np.vstack([Jk, J[K - 1:]])
+    return robust, A
+
+
+def _information(J, Jd, r, K, has_prior, noise, scale, names, errors):
+    """Rank, covariance and null space from one SVD of ``J`` (K-1 + p, p): ``F = J^T J = V diag(sJ^2) V^T``.
+
+    Returns ``svd`` (J's), ``sv`` (singular values of the data part ``Jd``),
+    ``rank``, ``cov`` (p, p; physical units, ``inf``/NaN on non-identifiable
+    parameters), ``nonid`` (the null-space directions by name) and whether
+    every zero offset estimated is identifiable.
+    """
     UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False)
     sF = sJ**2
     sv = (np.linalg.svd(Jd, compute_uv=False) if has_prior else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
@@ -363,8 +365,13 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                 cov[k, k] = np.inf
         offsets_ok = all(not np.max(np.abs(null[:, names.index(n)])) > 1e-6
                          for n in errors.zero_offsets if n in names)
-    success = converged and offsets_ok
-    if not converged:
+    return (UJ, sJ, Vt), sv, rank, cov, nonid, offsets_ok
+
+
+def _status(sol, offsets_ok, rank, names, robust, loss) -> str:
+    """The result's status line: Ipopt's verdict, identifiability, the robust loss's outliers."""
+    ret = sol.ret
+    if not sol.converged:
         status = f"Ipopt did not converge: {ret}"
     elif not offsets_ok:
         status = (f"converged ({ret}) but the zero offsets are not identifiable from these poses "
@@ -379,57 +386,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                    "down-weighted as outliers (estimated error " +
                    ", ".join(f"{e:+.3g} mm" for e in robust["excluded_errors_mm"]) + ")" +
                    ("; estimate refitted without them" if robust["refit_without_outliers"] else ""))
-    info = {
-        "solver_status": ret,
-        "iterations": total_iter,
-        "cost": 0.5 * float(r @ r + rp @ rp),
-        "chi2": float(r @ r),
-        "dof": (K - 1) - len(names),
-        "time_s": None,
-        "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
-                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"),
-        "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
-        "warm_start": start,
-        "gauss_newton": {"converged": gn_ok, "last_step_mm": step},
-        "initial": x0.tolist(),
-        "rank": rank,
-        "singular_values": sv.tolist(),
-        "nonidentifiable": nonid,
-        "scale_mm_per_unit": scale.tolist(),
-        "prior": prior_q.tolist(),
-        "loss": loss,
-    }
-    if has_prior:
-        info["prior_whitener"] = w.tolist()
-    res = IdentificationResult(method="nlls", params=names, estimate=p_hat,
-                               covariance=cov, success=bool(success), status=status,
-                               residuals=np.asarray(s - pred), info=info, errors=errors,
-                               std_kind="from residuals" if noise.is_zero else "total")
-    # the fit check: whitened exact-model residuals at the estimate against the noise model
-    rows = np.flatnonzero(np.any(w != 0, axis=1))
-    if robust is None:
-        terms = None
-        if not rows.size and rank == len(names) and "fit_terms" in fast:  # the per-reading terms, O(K p)
-            terms = [o.copy() for o in fast["fit_terms"](r, Jd, l, b)]
-        lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
-                      np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
-                      None, np.arange(1, K), s - pred, np.eye(len(names)),
-                      scale, names, len(rows), band=(l, b),
-                      svd=None if rows.size else (UJ, sJ, Vt),  # no prior rows: J's SVD is Jd's
-                      terms=terms)
-        at = "estimate"
-    else:
-        lin = rb.robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
-        at = ("estimate, without the readings the robust loss down-weighted (at pose "
-              f"{', '.join(map(str, robust['excluded_readings']))})" if robust["excluded_readings"] else "estimate")
-        info["robust"] = {k: v for k, v in robust.items() if not k.startswith("_")}
-    tol_b = 1e-7 * (1.0 + np.abs(z))
-    active = [] if bounds is None else [n for n, zz, lo, hi, tb in zip(names, z, lbx, ubx, tol_b)
-                                        if zz <= lo + tb or zz >= hi - tb]
-    fitcheck.check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
-                          prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
-    info["time_s"] = time.perf_counter() - t0
-    return res
+    return status
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):

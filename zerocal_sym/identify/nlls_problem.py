@@ -58,6 +58,8 @@ IPOPT_OPTIONS = {
     "ipopt.nlp_scaling_method": "none",
     "ipopt.max_iter": 200,
     "print_time": False,
+    # a trial point where the model is undefined (NaN) is Ipopt's to step back from, not the user's to read
+    "show_eval_warnings": False,
 }
 
 #: up to this K the functions are SX, expanded (fastest to evaluate); above, MX graphs with the per-pose
