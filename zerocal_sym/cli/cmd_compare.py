@@ -77,6 +77,7 @@ def run(args):
     from zerocal_sym.cli._checks import PARAM_METHODS
     from zerocal_sym.cli._common import has_paper_tables, parse_named_values, poses_arg, require_paper_tables
     from zerocal_sym.errors import ZerocalError
+    from zerocal_sym.identify.montecarlo import format_compare
     from zerocal_sym.io.files import to_json, write_json
     from zerocal_sym.model.noise import NoiseModel
 
@@ -126,16 +127,10 @@ def run(args):
     rep["settings"]["mechanism"] = robot.mechanism_name
     if args.out:
         write_json(args.out, rep)
-    print(to_json(rep) if args.json else _text(rep, use_table2))
+    print(to_json(rep) if args.json else format_compare(rep))
     return 0
 
 
-def _text(rep, use_table2) -> str:
-    """The text report; with ``--set`` its one group (key ``set``) is headed ``true offsets`` (not ``set: set``)."""
-    from zerocal_sym.identify.montecarlo import format_compare
-
-    text = format_compare(rep)
-    return text if use_table2 else text.replace("\ngroup set: set offsets ", "\ngroup set: true offsets ", 1)
 
 
 def _run(args, robot, use_table2, groups, truth, common):

@@ -434,7 +434,7 @@ def format_compare(rep: dict) -> str:
         cr = go["crlb_zero_offsets_deg"]
         m = len(go["set_deg"])
         lines.append("")
-        lines.append(f"group {g}: set offsets {_vec(go['set_deg'], '+.3f')} deg;  CRLB "
+        lines.append(f"group {g}: true offsets {_vec(go['set_deg'], '+.3f')} deg;  CRLB "
                      + ("n/a" if cr is None else f"{_vec(cr, '.4f')} deg"))
         offs = ",".join(f"dth{k + 1}" for k in range(m))
         w = 11 * m
