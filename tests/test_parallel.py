@@ -146,6 +146,59 @@ def test_scheduler_errors_are_one_line(capsys, monkeypatch):
         assert "--workers" in err and len(err.splitlines()) == 1
 
 
+def test_scheduler_address_through_the_cli(tmp_path, capsys):
+    """``--scheduler ADDRESS`` of a running cluster: the CLI's own client (not the default one, there is
+    none) runs the chunks.  Before, ``as_completed`` looked for a default client: ValueError: No clients
+    found (the test above passes a Client, or an address while one is the default)."""
+    distributed = pytest.importorskip("distributed")
+    argv = ["compare", "--trials", "4", "--methods", "tsvd,nlls", "--seed", "2", "--quiet", "--json"]
+    assert main(argv) == 0
+    local = json.loads(capsys.readouterr().out)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
+                                  dashboard_address=None) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://")
+        assert main(argv + ["--scheduler", cluster.scheduler_address]) == 0
+        remote = json.loads(capsys.readouterr().out)
+    assert remote["execution"]["scheduler"] == cluster.scheduler_address
+    assert _numbers(local) == _numbers(remote)
+
+
+MALFORMED = {"nonsense": "no port number", "tcp://localhost": "no port number",
+             "http://localhost:8786": "unknown address scheme 'http://'", "bad:addr:x": "invalid address",
+             "tcp://localhost:99999": "port 99999 is out of range"}
+
+
+def test_malformed_scheduler_address_is_one_line_at_once(capsys):
+    pytest.importorskip("distributed")
+    for address, why in MALFORMED.items():
+        t0 = time.monotonic()
+        assert main(["compare", "--trials", "2", "--quiet", "--scheduler", address]) == 2
+        assert time.monotonic() - t0 < 3.0  # nothing contacted, no timeout waited for
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"--scheduler {address}: {why}" in err, err
+        assert "within" not in err and "tcp://host:8786" in err
+
+
+def test_malformed_scheduler_address_leaves_no_client_at_exit():
+    """Before, the client half-built by Client(address) was closed by its __del__ at interpreter exit: a
+    20 s hang, then 'Exception ignored in: <function Client.__del__> ... TimeoutError' on stderr."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("distributed")
+    code = ("import sys\nfrom zerocal_sym.cli import main\n"
+            "sys.exit(max(main(['compare', '--trials', '2', '--quiet', '--scheduler', a]) "
+            f"for a in {list(MALFORMED)!r}))")
+    t0 = time.monotonic()
+    try:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=15, cwd=ROOT)
+    except subprocess.TimeoutExpired as exc:
+        pytest.fail(f"the process did not exit: {(exc.stderr or b'').decode(errors='replace')}")
+    assert r.returncode == 2 and time.monotonic() - t0 < 10.0
+    assert len(r.stderr.strip().splitlines()) == len(MALFORMED), r.stderr
+    assert "Traceback" not in r.stderr and "Exception ignored" not in r.stderr
+
+
 # --------------------------------------------------------------------------- Ctrl-C
 
 def _interrupting_progress(log):
@@ -192,6 +245,47 @@ def test_interrupting_a_pool_prints_no_traceback_from_its_threads(monkeypatch):
             t.join(10.0)
             assert not t.is_alive(), t
     assert caught == []
+
+
+def test_workers_start_with_sigint_blocked(monkeypatch):
+    """A Ctrl-C to the process group while a worker's interpreter starts (before its initializer ignores
+    SIGINT) killed it with 'Fatal Python error: init_import_site ... KeyboardInterrupt' (5 of 24 SIGINTs
+    sent 5-100 ms after the workers appeared): the workers are spawned with SIGINT blocked.  The task
+    reports its process's mask as inherited (the initializer, which would unblock it, replaced)."""
+    import functools
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        pytest.skip("needs pthread_sigmask in the main thread")
+    monkeypatch.setattr(parallel, "_worker_init", os.getpid)  # a picklable no-op initializer
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    masks = parallel.run_chunks(functools.partial(signal.pthread_sigmask, signal.SIG_BLOCK), [[], []], workers=2)
+    assert all(signal.SIGINT in m for m in masks), masks
+    assert signal.pthread_sigmask(signal.SIG_BLOCK, []) == before  # restored here
+
+
+def test_ctrl_c_while_workers_start_is_raised_after():
+    """Another thread (OpenBLAS's, the CLI's) takes a SIGINT the main thread blocks: before, the parent
+    then raised KeyboardInterrupt inside a worker's spawn (the worker died on EOFError, a traceback).
+    It is held until the workers are started, then raised once, to the handler that was there."""
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        pytest.skip("needs pthread_sigmask in the main thread")
+    handler = signal.getsignal(signal.SIGINT)
+    go = threading.Event()
+    other = threading.Thread(target=lambda: go.wait(5) and os.kill(os.getpid(), signal.SIGINT))
+    other.start()  # before the block: it does not block SIGINT
+    reached = []
+    with pytest.raises(KeyboardInterrupt):
+        with parallel._sigint_deferred():
+            go.set()
+            other.join()
+            time.sleep(0.02)  # the main thread checks for signals here
+            reached.append("end of the spawn")
+    assert reached and signal.getsignal(signal.SIGINT) is handler
 
 
 def test_keyboard_interrupt_cli_writes_nothing(tmp_path, capsys, monkeypatch):

@@ -23,6 +23,10 @@ Interruption
     within a second: pending chunks are cancelled, local worker processes
     (which ignore SIGINT) are terminated, a Dask client we opened is closed,
     and the exception propagates.  Nothing is merged or written after it.
+    Local workers are started with SIGINT blocked (inherited from this
+    process) and a Ctrl-C is held while they are started, so one to the
+    process group then does not kill them half-initialised; it is raised
+    right after (:func:`_sigint_deferred`).
 
 This module holds the chunks (:func:`chunk_ranges`, :func:`trial_rng`) and
 their execution.  The mergeable statistics of the results are in
@@ -32,10 +36,12 @@ verification and the study runner) in :mod:`zerocal_sym.identify.one_shot`.
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import pickle
 import signal
+import threading
 import time
 
 import numpy as np
@@ -89,8 +95,48 @@ def trial_rng(seed: int, stream: int, trial: int) -> np.random.Generator:
 # --------------------------------------------------------------------------- execution
 
 def _worker_init():  # pragma: no cover - runs in the worker processes
-    # Ctrl-C goes to the whole process group: the parent decides (it terminates us)
+    # Ctrl-C goes to the whole process group: the parent decides (it terminates us).  SIGINT has been
+    # blocked since the process started (inherited, _sigint_deferred); ignoring it discards one that is
+    # pending, so it can be unblocked now.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextlib.contextmanager
+def _sigint_deferred():
+    """A Ctrl-C while the pool's worker processes are started is held until they are.
+
+    SIGINT is blocked in this (the main) thread: a child inherits the mask
+    through fork/exec, so a Ctrl-C (sent to the whole process group) while a
+    worker's interpreter is still starting, before its initializer ignores
+    SIGINT, stays pending instead of killing it with a ``Fatal Python error:
+    init_import_site`` traceback.  Other threads of this process (OpenBLAS's,
+    the CLI's) still take the signal, so the Python handler is replaced by one
+    that only notes it: the spawn is not interrupted half-way (the worker
+    then died on ``EOFError`` reading what it was to run).  On exit the mask
+    and the handler are restored and a noted Ctrl-C is raised again, to the
+    restored handler (a ``KeyboardInterrupt`` as usual).  Only in the main
+    thread (the mask is per thread; Python handles signals there).
+    """
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    noted = []
+    handler = signal.getsignal(signal.SIGINT)  # None: not set from Python, cannot be put back
+    if handler is not None:
+        signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        try:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # one pending for this thread: noted now
+        finally:
+            if handler is not None:
+                signal.signal(signal.SIGINT, handler)
+        if noted:
+            signal.raise_signal(signal.SIGINT)
 
 
 def _picklable(fn, tasks):
@@ -169,7 +215,9 @@ def _run_processes(fn, tasks, workers, finished):
     futs = {}
     ok = False
     try:
-        futs = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
+        with _sigint_deferred():  # Python 3.11 starts the spawn pool's processes in submit, in this thread
+            for i, t in enumerate(tasks):
+                futs[pool.submit(fn, t)] = i
         pending = set(futs)
         while pending:
             done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
@@ -199,7 +247,7 @@ def _stop_pool(pool, futs):
             p.terminate()
     manager = getattr(pool, "_executor_manager_thread", None)
     if procs and manager is not None:
-        manager.join(2.0)  # milliseconds when idle; bounded on a loaded machine
+        _join_started(manager, 2.0)  # milliseconds when idle; bounded on a loaded machine
     for f in futs:
         f.cancel()
     pool.shutdown(wait=False, cancel_futures=True)
@@ -216,13 +264,29 @@ def _stop_pool(pool, futs):
             p.join(0.5)
 
 
+def _join_started(thread, timeout):
+    """``thread.join(timeout)``, also when a Ctrl-C interrupted its ``start()`` (``submit`` starts the
+    manager thread and waits until it runs): the thread then comes up a moment later, and joining it
+    before that raised ``RuntimeError: cannot join thread before it is started``."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            thread.join(max(0.0, deadline - time.monotonic()))
+            return
+        except RuntimeError:  # not started (yet)
+            if time.monotonic() >= deadline:
+                return
+            time.sleep(0.005)
+
+
 def dask_client(scheduler):
     """``(client, owned)`` for a scheduler address or a Client (owned: we opened it and close it).
 
     Raises
     ------
     ZerocalError
-        dask.distributed is not installed, or the scheduler cannot be reached.
+        dask.distributed is not installed, the address is malformed (at once,
+        nothing contacted), or the scheduler cannot be reached.
     """
     try:
         from dask.distributed import Client
@@ -232,13 +296,58 @@ def dask_client(scheduler):
         return scheduler, False
     if not isinstance(scheduler, str) or not scheduler.strip():
         raise ZerocalError(f"--scheduler: expected an address like tcp://host:8786, got {scheduler!r}")
+    _check_address(scheduler)
     timeout = float(os.environ.get("ZEROCAL_SCHEDULER_TIMEOUT", SCHEDULER_TIMEOUT_S))
+    # Built in two steps to hold the client even when its constructor fails: one left half-open is closed
+    # now (milliseconds), not by its __del__ at interpreter exit, which waits 20 s for an event loop that
+    # has stopped and prints a TimeoutError traceback.
+    client = Client.__new__(Client)
     try:
-        client = Client(scheduler, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
+        client.__init__(scheduler, timeout=timeout, set_as_default=False)
+    except BaseException as exc:
+        _close_quietly(client)
+        if not isinstance(exc, Exception):  # KeyboardInterrupt
+            raise
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise ZerocalError(f"cannot reach the Dask scheduler at {scheduler} within {timeout:g} s: {msg}") from None
+        if isinstance(exc, (OSError, TimeoutError)):
+            raise ZerocalError(f"cannot reach the Dask scheduler at {scheduler} within {timeout:g} s: "
+                               f"{msg}") from None
+        raise ZerocalError(f"cannot connect to the Dask scheduler at {scheduler}: {msg}") from None
     return client, True
+
+
+def _check_address(address: str) -> None:
+    """A malformed scheduler address is an error before anything is contacted (no timeout to wait for)."""
+    from distributed.comm.addressing import parse_address
+    from distributed.comm.registry import get_backend
+
+    expected = "expected an address like tcp://host:8786"
+    scheme, loc = parse_address(address)
+    try:
+        backend = get_backend(scheme)
+    except ValueError:
+        raise ZerocalError(f"--scheduler {address}: unknown address scheme {scheme + '://'!r} "
+                           f"({expected})") from None
+    if scheme == "inproc":  # a scheduler in this process (LocalCluster(processes=False)): no host or port
+        return
+    try:
+        _host, port = backend.get_address_host_port(loc)
+    except NotImplementedError:  # a scheme without host and port
+        return
+    except ValueError as exc:
+        why = str(exc).splitlines()[0] if str(exc) else "invalid address"
+        if "missing port" in why:
+            why = "no port number"
+        raise ZerocalError(f"--scheduler {address}: {why} ({expected})") from None
+    if not 0 < int(port) < 65536:
+        raise ZerocalError(f"--scheduler {address}: port {port} is out of range 1..65535 ({expected})")
+
+
+def _close_quietly(client) -> None:
+    try:
+        client.close(timeout=2)
+    except Exception:  # noqa: BLE001 - it never connected: nothing to release that matters
+        pass
 
 
 def describe_scheduler(scheduler):
@@ -259,7 +368,7 @@ def _run_dask(fn, tasks, scheduler, finished):
     try:
         futs = [client.submit(fn, t, pure=False) for t in tasks]
         index = {f.key: i for i, f in enumerate(futs)}
-        for f in as_completed(futs):
+        for f in as_completed(futs, loop=client.loop):  # our client: never the default one
             finished(index[f.key], f.result())
     except BaseException:
         try:
