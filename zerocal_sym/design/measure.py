@@ -34,6 +34,67 @@ def _regressors(aq, vt):
     return np.column_stack([np.ones(len(vt)), aq]) / np.sqrt(vt)[:, None]
 
 
+def _value(criterion, R, W, q, w, escale=None):
+    """The convex form's value at ``w`` (:func:`_fgh`) and the factors its derivatives reuse.
+
+    Returns ``(f, st)``, ``st`` None (and ``f`` inf) when ``N`` is not positive definite.  The
+    backtracking of :func:`_restricted` needs the value alone.  Keep the arithmetic as it is,
+    operation for operation (and that of :func:`_grad_hess`): near the optimum the solver's
+    accept/reject decisions compare values that differ by round-off, so an equivalent but
+    reordered formula changes the support and weights of the measures it returns.
+    """
+    N = (R.T * w) @ R
+    try:
+        L = np.linalg.cholesky(N)
+    except np.linalg.LinAlgError:
+        return math.inf, None
+    if criterion == "D":
+        return -2 * float(np.sum(np.log(np.diag(L)))) + math.log(N[0, 0]), (N, L, None, None)
+    Li = np.linalg.inv(L)
+    Ninv = Li.T @ Li
+    if criterion != "E":
+        return float(np.sum(W * Ninv[1:, 1:])), (N, L, Ninv, None)
+    pi, V = np.linalg.eigh(Ninv[1:, 1:] / escale)
+    pi = np.maximum(pi, 0)
+    return float(np.sum(pi ** q)), (N, L, Ninv, (pi, V))
+
+
+def _grad_hess(criterion, R, W, q, st, escale=None, G00=None):
+    """Gradient and Hessian of the convex form (:func:`_fgh`) from the factors of :func:`_value`.
+
+    ``G00``: ``outer(g0, g0)`` (D; computed if not given).
+    """
+    N, L, Ninv, eig = st
+    if Ninv is None:
+        Li = np.linalg.inv(L)
+        Ninv = Li.T @ Li
+    Y = R @ Ninv
+    A = Y @ R.T
+    if criterion == "D":
+        g0 = R[:, 0] ** 2
+        N00 = N[0, 0]
+        H = A * A
+        H -= (np.outer(g0, g0) if G00 is None else G00) / N00 ** 2
+        return -np.diag(A) + g0 / N00, H
+    if criterion != "E":
+        Yp = Y[:, 1:]
+        Bm = Yp @ W @ Yp.T
+        H = 2 * A
+        H *= Bm
+        return -np.diag(Bm), H
+    pi, V = eig
+    Ua = (Y[:, 1:] / math.sqrt(escale)) @ V  # rows a_x = V^T u_x
+    Pq1 = (Ua * pi ** (q - 1)) @ Ua.T
+    ks = np.arange(q - 1)
+    Gam = np.einsum("ki,kj->ij", pi[None, :] ** ks[:, None], pi[None, :] ** (q - 2 - ks)[:, None])
+    Z = (Ua[:, :, None] * Ua[:, None, :]).reshape(len(Ua), -1)
+    H = 2 * A
+    H *= Pq1
+    H += (Z * Gam.ravel()) @ Z.T
+    H *= q
+    return -q * np.diag(Pq1), H
+
+
 def _fgh(criterion, R, W, q, w, escale=None):
     """Convex form of the criterion on regressors ``R`` (S, p + 1): value, gradient and Hessian in ``w``.
 
@@ -45,35 +106,10 @@ def _fgh(criterion, R, W, q, w, escale=None):
     (``A = R N^-1 R^T``, ``B = R N^-1 W~ N^-1 R^T``, ``U`` the rows
     ``(N^-1 g_x)_p``, ``Gamma`` the divided differences of ``pi^(q-1)``).
     """
-    N = (R.T * w) @ R
-    try:
-        L = np.linalg.cholesky(N)
-    except np.linalg.LinAlgError:
+    f, st = _value(criterion, R, W, q, w, escale)
+    if st is None:
         return math.inf, None, None
-    Li = np.linalg.inv(L)
-    Ninv = Li.T @ Li
-    Y = R @ Ninv
-    A = Y @ R.T
-    if criterion == "D":
-        g0 = R[:, 0] ** 2
-        N00 = N[0, 0]
-        f = -2 * float(np.sum(np.log(np.diag(L)))) + math.log(N00)
-        return f, -np.diag(A) + g0 / N00, A * A - np.outer(g0, g0) / N00 ** 2
-    if criterion != "E":
-        Yp = Y[:, 1:]
-        Bm = Yp @ W @ Yp.T
-        return float(np.sum(W * Ninv[1:, 1:])), -np.diag(Bm), 2 * A * Bm
-    P = Ninv[1:, 1:] / escale
-    pi, V = np.linalg.eigh(P)
-    pi = np.maximum(pi, 0)
-    Ua = (Y[:, 1:] / math.sqrt(escale)) @ V  # rows a_x = V^T u_x
-    Pq1 = (Ua * pi ** (q - 1)) @ Ua.T
-    f = float(np.sum(pi ** q))
-    ks = np.arange(q - 1)
-    Gam = np.einsum("ki,kj->ij", pi[None, :] ** ks[:, None], pi[None, :] ** (q - 2 - ks)[:, None])
-    Z = np.einsum("xi,xj->xij", Ua, Ua).reshape(len(w), -1)
-    H = q * (2 * A * Pq1 + (Z * Gam.ravel()) @ Z.T)
-    return f, -q * np.diag(Pq1), H
+    return (f, *_grad_hess(criterion, R, W, q, st, escale))
 
 
 def _restricted(criterion, W, q, R, w0, tol=1e-13, max_iter=200):
@@ -83,27 +119,36 @@ def _restricted(criterion, W, q, R, w0, tol=1e-13, max_iter=200):
     with ``sum(dw) = 0``; a step that would make a weight negative stops at
     zero and frees it; a zero weight whose gradient is below the multiplier
     is freed again.  Returns the weights, shape (S,).
+
+    The backtracking evaluates the value alone (:func:`_value`); the gradient
+    and Hessian are computed at the accepted point only, from its factors.  A
+    step that leaves the weights unchanged (bit for bit) and the free set as
+    it was would be repeated until ``max_iter``: it ends the loop.
     """
-    S = len(w0)
     w = np.maximum(np.asarray(w0, float), 0)
     w /= w.sum()
     escale = None
     if criterion == "E":
         N = (R.T * w) @ R
         escale = float(np.linalg.eigvalsh(np.linalg.inv(N)[1:, 1:])[-1])
+    G00 = np.outer(R[:, 0] ** 2, R[:, 0] ** 2) if criterion == "D" else None
     free = w > 0
-    f, g, H = _fgh(criterion, R, W, q, w, escale)
-    if g is None:
+    f, st = _value(criterion, R, W, q, w, escale)
+    if st is None:
         return w
+    g, H = _grad_hess(criterion, R, W, q, st, escale, G00)
     for _ in range(max_iter):
         F = np.flatnonzero(free)
         n = len(F)
-        Hf = H[np.ix_(F, F)]
+        Hf = H.take(F, 0).take(F, 1)
         reg = 1e-12 * max(float(np.trace(Hf)) / n, 1e-300)
         KKT = np.zeros((n + 1, n + 1))
         KKT[:n, :n] = Hf + reg * np.eye(n)
         KKT[:n, n] = KKT[n, :n] = 1.0
-        sol = np.linalg.lstsq(KKT, np.concatenate([-g[F], [0.0]]), rcond=None)[0]
+        rhs = np.zeros(n + 1)
+        gF = g[F]
+        rhs[:n] = -gF
+        sol = np.linalg.lstsq(KKT, rhs, rcond=None)[0]
         dw, nu = sol[:n], sol[n]
         lam = -nu  # multiplier: g_i = lam on the support at the optimum
         # free a zero weight that wants to grow
@@ -113,28 +158,42 @@ def _restricted(criterion, W, q, R, w0, tol=1e-13, max_iter=200):
             if len(viol) and np.max(np.abs(dw)) < 1e-9:
                 free[viol[np.argmin(g[viol])]] = True
                 continue
-        slope = float(g[F] @ dw)
+        slope = float(gF @ dw)
         if not slope < -tol * max(abs(f), 1e-300):
             if len(zero) and np.any(g[zero] < lam - 1e-10 * abs(lam)):
                 free[zero[np.argmin(g[zero])]] = True
                 continue
             break
+        wF = w[F]
         neg = dw < 0
-        tmax = float(np.min(-w[F][neg] / dw[neg])) if np.any(neg) else math.inf
+        if np.any(neg):
+            ratio = -wF[neg] / dw[neg]
+            k = int(np.argmin(ratio))
+            tmax, hit = float(ratio[k]), F[neg][k]
+        else:
+            tmax = math.inf
         t = min(1.0, tmax)
         while True:
             wn = w.copy()
-            wn[F] = np.maximum(w[F] + t * dw, 0)
+            wn[F] = np.maximum(wF + t * dw, 0)
             if t == tmax:
-                wn[F[neg][np.argmin(-w[F][neg] / dw[neg])]] = 0.0
+                wn[hit] = 0.0
             wn /= wn.sum()
-            fn, gn, Hn = _fgh(criterion, R, W, q, wn, escale)
-            if gn is not None and fn <= f + 1e-4 * t * slope:
+            fn, st = _value(criterion, R, W, q, wn, escale)
+            if st is not None and fn <= f + 1e-4 * t * slope:
                 break
             t *= 0.5
             if t < 1e-14:
                 return w
-        w, f, g, H = wn, fn, gn, Hn
+        if np.array_equal(wn, w):
+            # a null step (the value's decrease is below round-off): w, f, g and H are what they were
+            # (the same arithmetic on the same weights); with the same free set, every further pass
+            # would repeat this one until max_iter, and the result is w
+            if np.array_equal(w > 0, free):
+                return w
+        else:
+            w, f = wn, fn
+            g, H = _grad_hess(criterion, R, W, q, st, escale, G00)
         free = w > 0
     return w
 
@@ -229,17 +288,17 @@ def e_certificate(model: PoseModel, M, c):
         top = np.argsort(-np.sum(Hs ** 2, axis=1))[:400]
         Hs = Hs[top]
         tri = np.tril_indices(k)
+        Lz = np.zeros((k, k))  # its lower triangle rewritten by each zmat (the rest stays 0)
 
         def zmat(x):
-            Lz = np.zeros((k, k))
             Lz[tri] = x
             Z = Lz @ Lz.T
-            return Z / np.trace(Z)
+            return Z / Z.trace()
 
         def fmax(x, beta):
             vals = np.einsum("xi,ij,xj->x", Hs, zmat(x), Hs)
             m = vals.max()
-            return m + np.log(np.sum(np.exp(beta * (vals - m) / m))) * m / beta
+            return m + np.log(np.exp(beta * (vals - m) / m).sum()) * m / beta
 
         x = np.eye(k)[tri]
         for beta in (20.0, 200.0, 2000.0):
