@@ -74,7 +74,7 @@ class _Exact:
 
     def refine(self, z0, basis=None, max_iter: int = 10):
         """Gauss-Newton on the exact model from ``z0`` within ``span(basis)`` (weights re-evaluated)."""
-        from zerocal_sym.identify.nlls import GN_STEP_TOL
+        from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
 
         z = np.asarray(z0, float).copy()
         if basis is None or (np.shape(basis)[1] == self.p and not np.any(self.w)):
@@ -107,7 +107,7 @@ class _Exact:
             par[: self.theta.size] = np.asarray(theta, float).ravel()
         if readings is not None:
             par[self.prob.s_slice(len(self.robot.geometry), len(self.robot.errors))] = np.asarray(readings)[1:]
-        from zerocal_sym.identify.nlls import GN_STEP_TOL
+        from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
 
         out = self.prob.run_gauss_newton(self.z_prior, par, True, GN_STEP_TOL)
         r, rp = np.array(out[2]).ravel(), np.array(out[3]).ravel()

@@ -188,7 +188,7 @@ def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delt
     from zerocal_sym.identify.exact_refits import refits
     from zerocal_sym.identify.fitcheck import ROBUST_EXCLUDE_WEIGHT
     from zerocal_sym.identify.fitstats import DEFAULT_ALPHA
-    from zerocal_sym.identify.nlls import GN_STEP_TOL
+    from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
 
     pw = w if np.any(w) else None
     args = (robot, theta_cmd, meas.readings, names, prior_q, noise)

@@ -1,0 +1,155 @@
+"""The stages of :func:`~zerocal_sym.identify.nlls.identify_nlls` after its inputs are checked.
+
+:func:`solve` (Gauss-Newton inside one CasADi call, then Ipopt, whose status
+decides), :func:`robust_stage` (a robust loss from the l2 solution),
+:func:`information` (rank, covariance and null space from one SVD of the
+whitened, scaled Jacobian) and :func:`status_line`.  Shapes: K poses, p
+estimated parameters.
+"""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from zerocal_sym.identify.fitstats import RANK_RTOL
+
+#: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
+UNIT_SIGMA_MM = 1e-3
+#: Ipopt return statuses that count as converged (anything else: success False)
+CONVERGED_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+#: Gauss-Newton is converged when its last step is below this (scaled units, mm)
+GN_STEP_TOL = 1e-8
+
+
+def solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleNamespace:
+    """Gauss-Newton in one CasADi call, then Ipopt from its point: Ipopt's status decides.
+
+    If Gauss-Newton did not converge (or left the bounds) Ipopt starts at
+    ``z0`` and, with ``reweight``, solves once more with the weights at its
+    solution.  Returns ``z`` (p,), ``ret`` (Ipopt's status), ``converged``,
+    ``iterations`` (Ipopt's), ``gn_ok``, ``step`` (Gauss-Newton's last, mm)
+    and, at the final point, the weights ``l`` (K-1,), ``b`` (K-2,), the
+    whitened residuals ``r`` (K-1,) and prior residuals ``rp``, the Jacobian
+    ``J`` (K-1 + p, p) and the predicted changes ``pred`` (K-1,).
+    """
+    solver = prob.solver_for(max_iter)
+    fast = prob.fast
+    z_gn, step, r, rp, J, pred, l, b = prob.run_gauss_newton(z0, par, bool(reweight), GN_STEP_TOL)
+    step = float(step[0])
+    gn_ok = bool(np.isfinite(z_gn).all() and step < GN_STEP_TOL
+                 and (not bounded or (np.all(z_gn >= lbx) and np.all(z_gn <= ubx))))
+    if gn_ok:  # Ipopt confirms the Gauss-Newton point (weights at that point)
+        z, passes = z_gn, 1
+    else:      # Ipopt from the start; with reweight once more with the weights at its solution
+        z, passes = z0, 1 + bool(reweight)
+        l, b = (np.array(o) for o in fast["weights"](z0, par))
+    total_iter, stats = 0, {}
+    for k in range(passes):
+        if k:
+            l, b = (np.array(o) for o in fast["weights"](z, par))
+        Jz = J[: K - 1] if (gn_ok and not k) else fast["jfun"](z, par, l, b)[0]
+        c = 1.0 / max(1e-300, float(np.vdot(Jz, Jz)))  # GN Hessian of norm ~1 (Frobenius: no SVD)
+        zn = solver(z, np.concatenate([par, l, b, [c]]), lbx, ubx)[0].copy()
+        stats = solver.stats()
+        total_iter += int(stats.get("iter_count", 0))
+        moved = bool((zn != z).any())
+        z = zn
+        if str(stats.get("return_status")) not in CONVERGED_STATUSES:
+            break
+    ret = str(stats.get("return_status", "unknown"))
+    if not gn_ok or moved:  # residuals and Jacobian at the final point (else Gauss-Newton's are current)
+        l, b = (np.array(o) for o in fast["weights"](z if reweight else z0, par))
+        r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
+    return SimpleNamespace(z=z, ret=ret, converged=ret in CONVERGED_STATUSES and bool(np.isfinite(z).all()),
+                           iterations=total_iter, gn_ok=gn_ok, step=step, l=l, b=b, r=r.ravel(), rp=rp.ravel(),
+                           J=J, pred=pred.ravel())
+
+
+def robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w, z_prior, K):
+    """The robust loss from the l2 solution ``sol`` (or from the prior when Ipopt failed: an outlier can
+    cause that); updates ``sol`` in place (point, status, weights, residuals, and ``J`` to the information of
+    the readings kept or with the final robust weights).  Returns ``(robust, A)``: the robust stage's record
+    and ``d pred / d z`` (K-1, p)."""
+    from zerocal_sym.identify import robust as rb
+
+    fast = prob.fast
+    z_start = sol.z if (sol.converged and np.all(np.isfinite(sol.z))) else z_prior
+    z, robust, ok = rb.robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta, w, K)
+    robust["l2_solver_status"] = sol.ret
+    if not ok:
+        sol.converged, sol.ret = False, "robust iteration did not converge"
+    elif not sol.converged:
+        sol.converged, sol.ret = True, f"robust iteration converged; the l2 Ipopt solve: {sol.ret}"
+    sol.z = z
+    l, b = (np.array(o) for o in fast["weights"](z, par))
+    r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
+    A = -(np.diag(l.ravel()) + np.diag(np.ravel(b), -1)) @ J[: K - 1]   # d pred / d z
+    excl = np.asarray(robust["excluded_readings"], int) - 1
+    if robust["refit_without_outliers"]:  # information of the readings kept
+        keep = np.setdiff1d(np.arange(K - 1), excl)
+        Jk = np.zeros((K - 1, len(names)))
+        Jk[: keep.size] = np.linalg.solve(np.linalg.cholesky(robust["_C"][np.ix_(keep, keep)]), -A[keep])
+    else:  # information with the final robust weights: the data rows whitened by chol(C_w)
+        Jk = np.linalg.solve(np.linalg.cholesky(robust["_C_w"]), -A)
+    sol.l, sol.b, sol.r, sol.rp, sol.pred = l, b, r.ravel(), rp.ravel(), pred.ravel()
+    sol.J = np.vstack([Jk, J[K - 1:]])
+    return robust, A
+
+
+def information(J, Jd, r, K, has_prior, noise, scale, names, errors):
+    """Rank, covariance and null space from one SVD of ``J`` (K-1 + p, p): ``F = J^T J = V diag(sJ^2) V^T``.
+
+    Returns ``svd`` (J's), ``sv`` (singular values of the data part ``Jd``),
+    ``rank``, ``cov`` (p, p; physical units, ``inf``/NaN on non-identifiable
+    parameters), ``nonid`` (the null-space directions by name) and whether
+    every zero offset estimated is identifiable.
+    """
+    UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False)
+    sF = sJ**2
+    sv = (np.linalg.svd(Jd, compute_uv=False) if has_prior else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
+    tol = RANK_RTOL * (sF[0] if sF.size else 0.0)
+    rank = int(np.count_nonzero(sF > tol))
+    null = Vt[rank:]
+    if noise.is_zero:
+        dof = (K - 1) - rank
+        s2 = float(r @ r) * UNIT_SIGMA_MM**2 / dof if dof > 0 else np.nan
+    else:
+        s2 = 1.0
+    Finv = (Vt[:rank].T / sF[:rank]) @ Vt[:rank]
+    cov = s2 * Finv / np.outer(scale, scale)
+    nonid, offsets_ok = [], True
+    if null.size:  # rank deficient
+        for v in null:
+            v = v / scale  # direction in physical units
+            v = v / np.max(np.abs(v))
+            nonid.append({n: float(c) for n, c in zip(names, v) if abs(c) > 1e-6})
+        for k in range(len(names)):  # non-identifiable parameters get infinite variance
+            if np.max(np.abs(null[:, k])) > 1e-6:
+                cov[k, :] = np.nan
+                cov[:, k] = np.nan
+                cov[k, k] = np.inf
+        offsets_ok = all(not np.max(np.abs(null[:, names.index(n)])) > 1e-6
+                         for n in errors.zero_offsets if n in names)
+    return (UJ, sJ, Vt), sv, rank, cov, nonid, offsets_ok
+
+
+def status_line(sol, offsets_ok, rank, names, robust, loss) -> str:
+    """The result's status line: Ipopt's verdict, identifiability, the robust loss's outliers."""
+    ret = sol.ret
+    if not sol.converged:
+        status = f"Ipopt did not converge: {ret}"
+    elif not offsets_ok:
+        status = (f"converged ({ret}) but the zero offsets are not identifiable from these poses "
+                  f"with parameters {', '.join(names)} (rank {rank} of {len(names)})")
+    elif rank < len(names):
+        status = (f"converged ({ret}); rank {rank} of {len(names)}: some geometric combinations are "
+                  "not identifiable (see info['nonidentifiable'])")
+    else:
+        status = f"converged ({ret})"
+    if robust is not None and robust["excluded_readings"]:
+        status += (f"; {loss} loss: reading(s) at pose {', '.join(map(str, robust['excluded_readings']))} "
+                   "down-weighted as outliers (estimated error " +
+                   ", ".join(f"{e:+.3g} mm" for e in robust["excluded_errors_mm"]) + ")" +
+                   ("; estimate refitted without them" if robust["refit_without_outliers"] else ""))
+    return status
