@@ -114,8 +114,9 @@ def test_local_cluster_equals_local_run(robot, tmp_path):
     local = compare(robot, **kw)
     spec = _spec(tmp_path, trials=12, chunk=5)
     s_local = study.run_study(study_spec.load_spec(spec), tmp_path / "local")
+    # dashboard on a free port (":0"; None means 8787): two clusters at once, in two test workers, do not clash
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         remote = compare(robot, scheduler=client, **kw)
         by_address = compare(robot, scheduler=cluster.scheduler_address, **kw)
         s_remote = study.run_study(study_spec.load_spec(spec), tmp_path / "remote", scheduler=client)
@@ -155,7 +156,7 @@ def test_scheduler_address_through_the_cli(tmp_path, capsys):
     assert main(argv) == 0
     local = json.loads(capsys.readouterr().out)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:
         assert cluster.scheduler_address.startswith("tcp://")
         assert main(argv + ["--scheduler", cluster.scheduler_address]) == 0
         remote = json.loads(capsys.readouterr().out)
