@@ -295,3 +295,109 @@ def test_study_chunk_read_refuses_an_npy(tmp_path):
     p.write_bytes(buf.getvalue())
     with pytest.raises(ZerocalError, match="not a readable chunk file"):
         study_chunks.read_chunk(p, "c", "d", ["theta1"], 0, 3)
+
+
+# --------------------------------------------------------------------------- the new-user review (issues 1-7)
+
+def test_bogus_compile_mode_writes_nothing(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("ZEROCAL_COMPILE", "bogus")
+    out = tmp_path / "bogus"
+    _error(capsys, ["study", _spec(tmp_path), "--out", out], "ZEROCAL_COMPILE='bogus'")
+    assert not out.exists()
+    with pytest.raises(ZerocalError, match="ZEROCAL_COMPILE"):
+        study.run_study(study_spec.load_spec(_spec(tmp_path)), out)
+    assert not out.exists()
+
+
+def test_params_without_the_zero_offsets_is_refused(tmp_path, capsys):
+    spec = _spec(tmp_path, extra='params = "base"', design="n = 8")
+    _error(capsys, ["study", spec, "--out", tmp_path / "o"], f"{spec}:7:", "must contain the zero offsets theta1")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("mode", ["--summary", "--out"])
+def test_foreign_chunk_beyond_the_trials_is_refused(run, capsys, mode):
+    spec, out = run
+    bad = out / PAPER / "chunk-5.npz"
+    shutil.copyfile(out / PAPER / "chunk-1.npz", bad)
+    before = _tree(out)
+    _error(capsys, ["study", spec, mode, out, "--quiet"], str(bad), "holds trials 2..3", "trials 10..11")
+    assert _tree(out) == before
+
+
+def test_own_chunk_beyond_the_trials_is_kept_and_not_summarised(run):
+    spec, out = run
+    s = study_spec.load_spec(spec)
+    first = study.summarize(s, out)
+    spec.write_text(spec.read_text().replace("trials = 4", "trials = 2"))
+    s2 = study_spec.load_spec(spec)
+    assert study.plan(s2, out) == ([], 2)  # chunk-1 is beyond the 1 chunk: checked, kept, not counted
+    assert all(c["trials_done"] == 2 for c in study.summarize(s2, out)["cells"])
+    assert _numbers(study.summarize(s, out)) == _numbers(first)
+
+
+@pytest.mark.parametrize("text", ["", '{"format": "zerocal st'])
+def test_unreadable_cell_json_says_delete_it_alone(run, done, capsys, text):
+    spec, out = run
+    bad = out / PAPER / "cell.json"
+    bad.write_text(text)
+    line = _error(capsys, ["study", spec, "--out", out], str(bad), "not a readable cell record", "cell.json alone")
+    assert "other settings" not in line and "remove the cell's directory" not in line
+    bad.unlink()
+    assert main(["study", str(spec), "--out", str(out), "--quiet", "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert json.loads(bad.read_text())["study"] == "t"  # written again, though no chunk was run
+    assert again["run"]["chunks_run"] == 0
+    assert _numbers(again) == _numbers(json.loads((done / "out" / "summary.json").read_text()))
+
+
+def _rewrite(p, **change):
+    with np.load(p) as z:
+        cols = {k: z[k] for k in z.files}
+    for k, f in change.items():
+        cols[k] = f(cols[k])
+    np.savez(p, **cols)
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"est_theta1": lambda c: c.astype(str)}, ["column est_theta1", "not floating-point numbers"]),
+    ({"trial": lambda c: c.astype(float)}, ["trial column holds float64", "not integers"]),
+    ({"est_rMx": lambda c: np.where(np.arange(c.size) == 1, np.nan, c)}, ["row 1, trial 3", "est_rMx = nan"]),
+])
+def test_chunk_with_a_bad_column_says_what(run, capsys, change, words):
+    spec, out = run
+    bad = out / PAPER / "chunk-1.npz"
+    _rewrite(bad, **change)
+    for mode in ("--summary", "--out"):
+        _error(capsys, ["study", spec, mode, out], str(bad), *words)
+
+
+def test_text_chunk_is_not_a_chunk_file(run, capsys):
+    spec, out = run
+    _text(out / PAPER / "chunk-1.npz")
+    line = _error(capsys, ["study", spec, "--summary", out], "not an npz archive")
+    assert "pickle" not in line
+
+
+@pytest.mark.parametrize("opt", [["--workers", "2"], ["--scheduler", "bad"], ["--workers", "1"]])
+def test_summary_refuses_the_run_options(run, capsys, opt):
+    spec, out = run
+    _error(capsys, ["study", spec, "--summary", out, *opt], opt[0], "--summary")
+
+
+def test_summary_of_a_file(tmp_path, capsys):
+    spec = _spec(tmp_path)
+    _error(capsys, ["study", spec, "--summary", spec], str(spec), "is a file (the spec?)", "output directory")
+
+
+@pytest.mark.parametrize("edit, where, words", [
+    (("[[truth]]", "[[truths]]"), 11, ["unknown key 'truths'"]),
+    (("[[design]]", "[[designs]]"), 8, ["unknown key 'designs'"]),
+    (("[[design]]", "[design]"), 8, ["[design] is a single table", "[[design]]"]),
+    (("theta1 = 2", "theta1 = 200"), 13, ["theta1 = 200 deg", "plausible 10 deg"]),
+])
+def test_spec_messages_point_at_the_line(tmp_path, capsys, edit, where, words):
+    spec = _spec(tmp_path)
+    spec.write_text(spec.read_text().replace(*edit))
+    _error(capsys, ["study", spec, "--out", tmp_path / "o"], f"{spec}:{where}:", *words)
+    assert not (tmp_path / "o").exists()

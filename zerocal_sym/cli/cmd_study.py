@@ -71,12 +71,27 @@ def run(args):
     from zerocal_sym.identify.progress import Progress
     from zerocal_sym.io.files import to_json
 
+    from zerocal_sym.model.compiled import mode
+
     if getattr(args, "robot", None):
         raise ZerocalError("--robot: a study's robots are listed in its spec (robots = [...])")
+    if args.summary is not None:
+        given = getattr(args, "_given", None)
+        bad = [o for o, d, default in (("--workers", "workers", 1), ("--scheduler", "scheduler", None))
+               if (d in given if given is not None else getattr(args, d) != default)]
+        if bad:
+            raise ZerocalError(f"{', '.join(bad)}: where the study runs (--out DIR); --summary only reads the chunk "
+                               "files on disk")
+    mode()  # ZEROCAL_COMPILE: a bogus value is a user error before anything is read or written
     spec = load_spec(args.spec)
     if args.summary is not None:
+        if Path(args.summary).is_file():
+            raise ZerocalError("is a file" + (" (the spec?)" if Path(args.summary).suffix == ".toml" else "")
+                               + ": --summary expects the study's output directory (the --out DIR of a run)",
+                               where=args.summary)
         if not Path(args.summary).is_dir():
-            raise ZerocalError("no such study directory", where=args.summary)
+            raise ZerocalError("no such study directory (--summary expects the --out DIR of a run)",
+                               where=args.summary)
         summary = st.summarize(spec, args.summary)
     else:
         ex = _parallel.execution(args)

@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.cli.study_chunks import ChunkError, _cell_json, check_directory, chunk_path, read_chunk, write_chunk
+from zerocal_sym.cli.study_chunks import _CHUNK_RE, ChunkError, _cell_json, check_directory, chunk_path, read_chunk, write_chunk
 from zerocal_sym.cli.study_spec import Study, load_spec  # noqa: F401 - load_spec kept importable from here (benchmarks)
 from zerocal_sym.identify.one_shot import OneShotTask, one_shot_chunk
 from zerocal_sym.identify.parallel import chunk_ranges, describe_scheduler, run_chunks
@@ -60,6 +60,10 @@ def plan(study: Study, out) -> tuple:
     todo, done, bad = [], 0, []
     for cell in study.cells:
         digest = cell.digest(study)
+        try:
+            beyond_chunks(study, out, cell, digest)
+        except ChunkError as exc:
+            bad.append(exc)
         for k, (a, b) in enumerate(chunk_ranges(study.trials, study.chunk)):
             p = chunk_path(out, cell, k)
             try:
@@ -76,6 +80,44 @@ def plan(study: Study, out) -> tuple:
         more = f" ({n} other chunk file{'s are' if n > 1 else ' is'} refused too)" if n else ""
         raise ChunkError(bad[0].message + more, where=bad[0].where)
     return todo, done
+
+
+def beyond_chunks(study: Study, out, cell, digest) -> int:
+    """Check the chunk files of ``cell`` whose index is beyond its chunks (``chunk-<k>.npz``, ``k >= chunks``).
+
+    Such a file is left by a run with more trials (it is read again if
+    ``trials`` grows back) or it was put there: it is checked like the others
+    (its cell record, its trials ``k*chunk ..``), not summarised.
+
+    Returns
+    -------
+    int
+        How many there are.
+
+    Raises
+    ------
+    ChunkError
+        The first that does not belong (damaged, another cell's, other trials), with the number of others.
+    """
+    d = Path(out) / cell.id
+    if not d.is_dir():
+        return 0
+    n, bad = 0, []
+    for p in sorted(d.iterdir()):
+        m = _CHUNK_RE.match(p.name)
+        if not m or p.name != f"chunk-{int(m.group(1))}.npz" or int(m.group(1)) < study.chunks_per_cell:
+            continue
+        k = int(m.group(1))
+        n += 1
+        try:
+            read_chunk(p, cell.id, digest, cell.params, k * study.chunk, (k + 1) * study.chunk, columns=False)
+        except ChunkError as exc:
+            bad.append(exc)
+    if bad:
+        more = len(bad) - 1
+        raise ChunkError(bad[0].message + (f" ({more} other chunk file{'s are' if more > 1 else ' is'} refused too)"
+                                           if more else ""), where=bad[0].where)
+    return n
 
 
 def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None, log=None,
@@ -111,7 +153,10 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     """
     from zerocal_sym.io.files import write_json
 
+    from zerocal_sym.model.compiled import mode
+
     out = Path(out)
+    mode()  # ZEROCAL_COMPILE: a bogus value is a user error before anything is written
     check_directory(out, study, run=True)
     for cell in study.cells:
         _cell_json(out, cell, study, check_only=True)
@@ -126,8 +171,9 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     t0 = time.perf_counter()
     if todo:  # the summary of an earlier run no longer describes the directory: gone before the first chunk
         (out / "summary.json").unlink(missing_ok=True)
-    for cell in {c.id: c for c, *_ in todo}.values():
-        _cell_json(out, cell, study)
+    for cell in study.cells:  # the cells to run, and those whose (unreadable) cell.json was deleted
+        if cell.id in {c.id for c, *_ in todo} or (out / cell.id).is_dir():
+            _cell_json(out, cell, study)
     digests = {c.id: c.digest(study) for c, *_ in todo}
     tasks = [OneShotTask(c.robot, c.theta, c.truth, c.noise, c.params, study.seed, c.stream, a, b)
              for c, k, a, b in todo]
@@ -181,6 +227,7 @@ def summarize(study: Study, out) -> dict:
     for cell in study.cells:
         _cell_json(out, cell, study, check_only=True)  # chunks of other settings are not merged
         digest = cell.digest(study)
+        beyond_chunks(study, out, cell, digest)  # not summarised, but refused if not the cell's
         errors = cell.robot.errors
         names = cell.params
         conv = np.array([math.degrees(1.0) if errors[n].unit == "rad" else 1.0 for n in names])

@@ -92,6 +92,11 @@ def read_chunk(path, cell_id: str, digest: str, params, start, stop, columns: bo
     """
     need = ["trial", "chi2", "success", "confirmed"] + [f"est_{n}" for n in params] + [f"std_{n}" for n in params]
     where = str(path)
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    if head[:2] != b"PK":  # np.load would try a pickle (its allow_pickle advice) or an .npy
+        what = "an empty file" if not head else "not an npz archive (a chunk file is a zip of arrays)"
+        raise ChunkError(f"not a readable chunk file ({what}): {_DELETE}", where=where)
     try:  # our handle: np.load leaks its own when the zip is unreadable
         with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             files = set(z.files)
@@ -114,8 +119,16 @@ def read_chunk(path, cell_id: str, digest: str, params, start, stop, columns: bo
             raise ChunkError(f"holds results of cell {cell_id!r} under other settings than its cell.json (a file "
                              f"copied from another run): {_DELETE}", where=where)
     trial = cols["trial"]
+    if not np.issubdtype(trial.dtype, np.integer):
+        raise ChunkError(f"not a valid chunk file (its trial column holds {trial.dtype} values, not integers): "
+                         f"{_DELETE}", where=where)
+    for k in need[1:]:
+        kind = "b" if k in ("success", "confirmed") else "f"
+        if cols[k].dtype.kind != kind:
+            raise ChunkError(f"not a valid chunk file (its column {k} holds {cols[k].dtype} values, not "
+                             f"{'booleans' if kind == 'b' else 'floating-point numbers'}): {_DELETE}", where=where)
     n = trial.shape[0] if trial.ndim == 1 else -1
-    if n < 1 or not np.issubdtype(trial.dtype, np.integer) or any(cols[k].shape != (n,) for k in need):
+    if n < 1 or any(cols[k].shape != (n,) for k in need):
         raise ChunkError(f"not a valid chunk file (its columns are not {max(n, 0)} values each): {_DELETE}",
                          where=where)
     if not np.array_equal(trial, np.arange(trial[0], trial[0] + n)):
@@ -124,6 +137,12 @@ def read_chunk(path, cell_id: str, digest: str, params, start, stop, columns: bo
     if int(trial[0]) != start:
         raise ChunkError(f"holds trials {int(trial[0])}..{int(trial[-1])}, this chunk is trials {start}..{stop - 1} "
                          f"(a file copied or renamed): {_DELETE}", where=where)
+    ok = cols["success"]
+    for k in [f"est_{p}" for p in params]:
+        bad = np.flatnonzero(ok & ~np.isfinite(cols[k]))
+        if bad.size:  # the runner marks a trial without a finite estimate failed: this file was altered
+            raise ChunkError(f"not a valid chunk file (row {int(bad[0])}, trial {int(trial[bad[0]])}, is marked "
+                             f"successful with {k} = {cols[k][bad[0]]}): {_DELETE}", where=where)
     if n != stop - start:
         return None  # trials changed: this (last) chunk is recomputed
     return cols if columns else True
@@ -142,14 +161,18 @@ def _cell_json(out, cell, study, check_only=False):
     if p.exists():
         try:
             have = json.loads(p.read_text())
-        except (OSError, ValueError):
-            have = None
-        if isinstance(have, dict):
-            have = {k: v for k, v in have.items() if k != "study"}
+        except (OSError, ValueError) as exc:
+            why = "an empty file" if not p.stat().st_size else f"{type(exc).__name__}: {exc}"
+            raise ZerocalError(f"not a readable cell record ({why}): delete this cell.json alone (not the chunk "
+                               "files beside it: each records its cell and is checked on its own) and run the study "
+                               "with --out, which writes it again", where=str(p)) from None
+        if not isinstance(have, dict):
+            raise ZerocalError("not a cell record (not a JSON object): delete this cell.json alone and run the "
+                               "study with --out, which writes it again", where=str(p))
+        have = {k: v for k, v in have.items() if k != "study"}
         if have != json.loads(json.dumps(want)):
-            diff = sorted(k for k in want if not isinstance(have, dict)
-                          or have.get(k) != json.loads(json.dumps(want[k])))
-            raise ZerocalError(f"this cell was run with other settings ({', '.join(diff) or 'unreadable'}): use "
+            diff = sorted(k for k in want if have.get(k) != json.loads(json.dumps(want[k])))
+            raise ZerocalError(f"this cell was run with other settings ({', '.join(diff) or 'format'}): use "
                                "another output directory or remove the cell's directory", where=str(p))
         return
     if not check_only:

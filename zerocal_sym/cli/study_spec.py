@@ -152,7 +152,17 @@ class _Where:
                 if re.match(rf"\s*(\"?){re.escape(key)}\1\s*=", self.lines[j]):
                     line = j + 1
                     break
+            else:
+                if table is None:  # a table of that name: [key] or [[key]]
+                    line = self.header(key)
         return f"{self.path}:{line}" if line else self.path
+
+    def header(self, key):
+        """The line (1-based) of the first ``[key]`` or ``[[key]]`` header, or None."""
+        for j, ln in enumerate(self.lines):
+            if re.match(rf"\s*\[\[?\s*(\"?){re.escape(key)}\1\s*\]", ln):
+                return j + 1
+        return None
 
 
 def _slug(s: str) -> str:
@@ -270,6 +280,7 @@ def load_spec(path) -> Study:
     """
     from zerocal_sym.cli._checks import identifiability_problem
     from zerocal_sym.cli._common import parse_named_values
+    from zerocal_sym.identify.fitcheck import DEFAULT_MAX_OFFSET_DEG
     from zerocal_sym.model import kinematics as kin
 
     from zerocal_sym.model.robot import read_toml
@@ -305,6 +316,9 @@ def load_spec(path) -> Study:
     noises = _noise_levels(raw.get("noise", ["paper"]), where)
     designs, truths = raw.get("design"), raw.get("truth")
     for key, tabs in (("design", designs), ("truth", truths)):
+        if isinstance(tabs, dict):
+            raise StudySpecError(f"[{key}] is a single table: write [[{key}]] (double brackets: one or more "
+                                 f"[[{key}]] tables)", where=where(key))
         if not isinstance(tabs, list) or not tabs or not all(isinstance(t, dict) for t in tabs):
             raise StudySpecError(f"at least one [[{key}]] table is needed", where=where(key))
     study = Study(path=path, name=name, seed=seed, trials=trials, chunk=chunk, params=params, streams=streams)
@@ -314,6 +328,10 @@ def load_spec(path) -> Study:
             names = robot.errors.resolve(params)
         except ValueError as exc:
             raise StudySpecError(f"params for robot {rl!r}: {exc}", where=where("params")) from None
+        offs = robot.errors.zero_offsets
+        if any(n not in names for n in offs):  # the words of compare's check (identify/montecarlo.py)
+            raise StudySpecError(f"params = {params!r} for robot {rl!r}: the parameter set must contain the zero "
+                                 f"offsets {', '.join(offs)}", where=where("params"))
         for di, dt in enumerate(designs):
             def wd(key, _i=di):
                 return where(key, "design", _i)
@@ -360,6 +378,10 @@ def load_spec(path) -> Study:
                     if not _is_num(v):
                         raise StudySpecError(f"{k} = {v!r}: expected a finite number (deg for angles, mm otherwise)",
                                              where=wt(k))
+                    if k in robot.errors.zero_offsets and abs(v) > DEFAULT_MAX_OFFSET_DEG:
+                        raise StudySpecError(f"{k} = {v!r} deg: beyond the plausible {DEFAULT_MAX_OFFSET_DEG:g} deg "
+                                             "of a zero offset (the identification's plausibility limit; the "
+                                             "truth is in degrees)", where=wt(k))
                 try:
                     user = parse_named_values([f"{k}={v}" for k, v in values.items()], robot, "truth")
                 except ZerocalError as exc:
