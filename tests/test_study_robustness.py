@@ -401,3 +401,17 @@ def test_spec_messages_point_at_the_line(tmp_path, capsys, edit, where, words):
     spec.write_text(spec.read_text().replace(*edit))
     _error(capsys, ["study", spec, "--out", tmp_path / "o"], f"{spec}:{where}:", *words)
     assert not (tmp_path / "o").exists()
+
+
+def test_interrupted_inside_a_line_ends_it_first(run, capsys, monkeypatch):
+    spec, out = run
+    spec.write_text(spec.read_text().replace("trials = 4", "trials = 6"))
+
+    def cut(self, done):  # Ctrl-C inside a progress line, before its newline
+        self.stream.write("study [###")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Progress, "__call__", cut)
+    assert main(["study", str(spec), "--out", str(out)]) == 130
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("study t: 2 cells x 3 chunks") and lines[-1] == "zerocal study: interrupted", lines

@@ -61,6 +61,34 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
+class _LineEnd:
+    """stderr, remembering whether the last text written to it ended its line.
+
+    A Ctrl-C inside a write (the account of the chunks, a progress line) may
+    cut it before its newline: the run ends that line before "interrupted".
+    """
+
+    def __init__(self, stream):
+        self.stream, self.open = stream, False
+
+    def write(self, text):
+        if text:
+            self.open = True  # until the write is through
+        n = self.stream.write(text)
+        if text:
+            self.open = not text.endswith("\n")
+        return n
+
+    def end_line(self):
+        if self.open:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.open = False
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+
 def run(args):
     from pathlib import Path
 
@@ -94,19 +122,27 @@ def run(args):
                                where=args.summary)
         summary = st.summarize(spec, args.summary)
     else:
+        import sys
+
+        err = _LineEnd(sys.stderr)
         ex = _parallel.execution(args)
         bars = []
 
         def make_progress(total):
-            bars.append(Progress(total, "study", enabled=not args.quiet and total > 0))
+            bars.append(Progress(total, "study", stream=err, enabled=not args.quiet and total > 0))
             return bars[-1]
 
+        def log(text):
+            err.write(text + "\n")  # one write: the line and its end
+            err.flush()
+
         try:
-            summary = st.run_study(spec, args.out, log=None if args.quiet else st.log_stderr,
-                                   make_progress=make_progress, **ex)
+            summary = st.run_study(spec, args.out, log=None if args.quiet else log, make_progress=make_progress,
+                                   **ex)
         finally:
             for b in bars:
                 b.close()
+            err.end_line()  # interrupted inside a line: "zerocal study: interrupted" on its own
             _parallel.close(ex)
     print(to_json(summary) if args.json else st.format_summary(summary))
     return 0

@@ -314,4 +314,5 @@ def format_summary(s: dict) -> str:
 
 
 def log_stderr(text: str) -> None:
-    print(text, file=sys.stderr, flush=True)
+    sys.stderr.write(text + "\n")  # one write: a Ctrl-C cannot fall between the line and its end
+    sys.stderr.flush()
