@@ -18,6 +18,7 @@ import argparse
 import importlib
 import os
 import pkgutil
+import signal
 import sys
 
 from zerocal_sym.errors import ZerocalError
@@ -117,9 +118,15 @@ def main(argv=None) -> int:
         raise
 
 
+#: set by the console entry point: an interrupted command there ends the process (see _interrupted)
+_CONSOLE = False
+
+
 def _interrupted(args) -> int:
     from zerocal_sym.model.compiled import stop_builds
 
+    if _CONSOLE:  # the process ends with 130: a burst of Ctrl-C (GNU timeout signals twice) must not cut that short
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     stop_builds()  # a compiler building in the background stops too (zerocal_sym.model.compiled)
     print(f"zerocal {args.command}: interrupted", file=sys.stderr)
     return 130
@@ -144,9 +151,12 @@ def _stdout_closed() -> int:
 
 
 def entry() -> None:  # console script
+    global _CONSOLE
+    _CONSOLE = True
     try:
         status = main()
     except KeyboardInterrupt:  # before a command ran (while parsing, importing)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         print("zerocal: interrupted", file=sys.stderr)
         status = 130
     except BrokenPipeError:

@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import _thread
 import contextlib
+import os
 import signal
 import sys
 import threading
+import time
 
 
 def is_interrupt(exc) -> bool:
@@ -40,40 +42,65 @@ def is_interrupt(exc) -> bool:
 
 
 class _Redeliver:
-    """Keeps a Ctrl-C pending until Python code has it (a helper thread re-trips SIGINT after each raise)."""
+    """Keeps a Ctrl-C pending until Python code has it (a helper thread re-trips SIGINT after each raise).
+
+    The handler only writes a byte to a pipe the helper thread reads (it
+    takes no lock): two SIGINTs microseconds apart (GNU ``timeout`` signals
+    the process and then its group) run the handler again inside the first
+    run, and a lock taken there (``threading.Event.set``, as before) was held
+    by the interrupted run itself: the command hung for good.
+    """
 
     #: how long after a raise the signal is made pending again (s): time for C code to return
     DELAY = 0.05
 
     def __init__(self):
         self.lock = threading.Lock()
-        self.kick = threading.Event()
         self.closed = False
+        self._r, self._w = os.pipe()
         self.thread = threading.Thread(target=self._run, name="zerocal-ctrl-c", daemon=True)
         self.thread.start()
 
     def _run(self):
-        while True:
-            self.kick.wait()
-            self.kick.clear()
-            if self.closed:
-                return
-            threading.Event().wait(self.DELAY)
-            with self.lock:
+        try:
+            while True:
+                try:
+                    os.read(self._r, 4096)  # a burst of Ctrl-C: one re-trip
+                except OSError:
+                    return
                 if self.closed:
                     return
-                _thread.interrupt_main()  # the main thread runs the handler at its next check
+                time.sleep(self.DELAY)
+                with self.lock:
+                    if self.closed:
+                        return
+                    _thread.interrupt_main()  # the main thread runs the handler at its next check
+        finally:
+            os.close(self._r)
+
+    def _kick(self):
+        if self.closed:  # (set before the pipe is closed; the handler and close() share the main thread)
+            return
+        try:
+            os.write(self._w, b"!")
+        except OSError:  # closed: nothing to re-trip
+            pass
 
     def handler(self, signum, frame):
         if is_interrupt(sys.exc_info()[1]):  # already on its way up: let the cleanup run
             return
-        self.kick.set()  # pending again soon, in case C code swallows this one
+        self._kick()  # pending again soon, in case C code swallows this one
         raise KeyboardInterrupt
 
     def close(self):
         with self.lock:
             self.closed = True
-        self.kick.set()
+        self._kick()
+        self.thread.join(1.0)
+        try:
+            os.close(self._w)
+        except OSError:
+            pass
 
 
 def _noop(*args):
@@ -96,7 +123,7 @@ def installed():
     try:
         yield
     finally:
-        redeliver.close()
         signal.signal(signal.SIGINT, _noop)  # a re-trip still pending is taken here, not by the caller
+        redeliver.close()
         _noop()
         signal.signal(signal.SIGINT, previous)
