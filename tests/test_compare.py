@@ -89,3 +89,16 @@ def test_cli_compare_errors(capsys):
     assert main(["compare", "--trials", "1", "--group", "9"]) == 2
     err = capsys.readouterr().err
     assert "--trials" in err and "unknown parameter" in err and "1..6" in err
+
+
+@pytest.mark.parametrize("params", ["offsets", "theta1,theta2"])
+def test_parameter_sets_without_the_maemm(robot, params):
+    """The one-shot nlls (the batch) reports the MAEMM it holds at its prior, zero, as scipy's row does
+    (it raised ValueError from BatchResult.values after the whole run)."""
+    rep = compare(robot, groups=[1], trials=3, params=params, methods=("nlls", "scipy"), seed=1, geometric=False)
+    g = rep["groups"]["1"]["methods"]
+    assert g["nlls"]["failures"] == 0 and np.all(np.isfinite(g["nlls"]["rms_deg"]))
+    # the MAEMM held at zero in every trial: its error is the same constant (minus the truth) each time
+    np.testing.assert_allclose(np.abs(g["nlls"]["bias_maemm_mm"]), g["nlls"]["rms_maemm_mm"], rtol=1e-12)
+    assert max(g["nlls"]["rms_maemm_mm"]) > 0.1
+    assert "group 1: true offsets" in format_compare(rep)
