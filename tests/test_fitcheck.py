@@ -206,6 +206,20 @@ def test_robust_loss_recovers_the_offsets_where_l2_does_not(case):
         assert res.info["fit"]["dof"] == case.th_large.shape[0] - 2 - len(case.names)
 
 
+def test_robust_loss_that_leaves_out_many_readings_is_rejected(robot):
+    """A model that does not fit (the MAEMM left out of the parameters): huber left out 3 of the 5 readings
+    and the 2 left, fitted by 1 parameter, passed the check: a confident wrong offset.  Rejected now."""
+    th = kin.ik(robot, paper_poses(robot, 3))
+    truth = robot.errors.assemble((2.0, -1.0), None, (1.0, 0.5))  # deg, mm
+    m = Measurements(th, VirtualPlant(robot, truth).measure(th, PAPER, np.random.default_rng(0)))
+    res = identify_nlls(robot, m, "theta1", noise=PAPER, loss="huber")
+    n_out = len(res.info["robust"]["excluded_readings"])
+    assert n_out > 1 and not res.success and res.status.startswith(f"rejected: the huber loss left out {n_out}")
+    assert res.info["fit"]["rejected"] and res.info["fit"]["robust_exclusion_limit"] == 1
+    kept = identify_nlls(robot, m, "theta1", noise=PAPER, loss="huber", accept_misfit=True)
+    assert kept.success and kept.status.startswith("accepted despite misfit (the huber loss left out")
+
+
 def test_robust_loss_under_the_paper_noise(robot):
     th = kin.ik(robot, paper_poses(robot, 6))
     truth = group_errors(1, "paper")

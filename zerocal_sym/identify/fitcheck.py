@@ -84,6 +84,14 @@ DEFAULT_MAX_MAEMM_MM = 50.0
 #: a reading whose robust weight ends below this is an outlier: named, and left out of the fit check
 #: (huber: |scale error| > 4 loss scales; soft_l1: > 3.9 loss scales)
 ROBUST_EXCLUDE_WEIGHT = 0.25
+#: a robust fit may leave out at most this fraction of the K - 1 readings (at least one): beyond, the data
+#: are not a good set with a few bad readings but a model that does not fit them, and the fit is rejected
+ROBUST_MAX_EXCLUDED_FRACTION = 0.25
+
+
+def robust_exclusion_limit(n_readings: int) -> int:
+    """How many of ``n_readings`` readings a robust fit may leave out (:data:`ROBUST_MAX_EXCLUDED_FRACTION`)."""
+    return max(1, int(ROBUST_MAX_EXCLUDED_FRACTION * n_readings))
 
 
 def _exact_for(robot, meas, result, noise=None) -> tuple:

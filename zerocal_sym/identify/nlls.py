@@ -244,8 +244,40 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                                         if zz <= lo + tb or zz >= hi - tb]
     fitcheck.check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
                           prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
+    if robust is not None:
+        _limit_outliers(res, robust, loss, K, accept_misfit)
     info["time_s"] = time.perf_counter() - t0
     return res
+
+
+def _limit_outliers(res, robust, loss, K, accept_misfit):
+    """Reject a robust fit that left out more readings than :func:`fitcheck.robust_exclusion_limit` allows.
+
+    A robust loss copes with a bad reading or a few; when it down-weights many,
+    the fit of the rest is not evidence for the estimate (with a wrong robot
+    file, 3 of 5 readings left out and the other 2 fitted by 1 parameter
+    "passed" the check).  ``accept_misfit`` keeps it, saying so.
+    """
+    n_out, limit = len(robust["excluded_readings"]), fitcheck.robust_exclusion_limit(K - 1)
+    res.info["fit"]["robust_exclusion_limit"] = limit
+    if n_out <= limit or not res.success:
+        return
+    why = (f"the {loss} loss left out {n_out} of the {K - 1} readings (at most {limit}: a robust loss copes with "
+           "a bad reading or a few, not with a model that does not fit the data: the robot file, the parameters "
+           "estimated, the noise model)")
+    if accept_misfit:
+        res.status = f"accepted despite misfit ({why}); {res.status}"
+        res.info["fit"]["accepted_despite_misfit"] = True
+    else:
+        res.success = False
+        res.status = f"rejected: {why}"
+    fit = res.info["fit"]
+    fit["rejected"] = True
+    kept = fit.get("diagnosis") or ""
+    fit["diagnosis"] = (f"The {loss} loss left out the readings at pose "
+                        f"{', '.join(map(str, robust['excluded_readings']))}: more than {limit} of {K - 1}, so the "
+                        "data do not fit the model, whatever the few readings left say"
+                        + (f" (of those: {kept[0].lower() + kept[1:]})" if kept else "."))
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):

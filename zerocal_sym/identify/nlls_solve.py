@@ -63,7 +63,7 @@ def solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleName
         r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
     return SimpleNamespace(z=z, ret=ret, converged=ret in CONVERGED_STATUSES and bool(np.isfinite(z).all()),
                            iterations=total_iter, gn_ok=gn_ok, step=step, l=l, b=b, r=r.ravel(), rp=rp.ravel(),
-                           J=J, pred=pred.ravel())
+                           J=np.reshape(J, (-1, z.size)), pred=pred.ravel())  # (a column when p = 1)
 
 
 def robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w, z_prior, K):
@@ -84,6 +84,7 @@ def robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, 
     sol.z = z
     l, b = (np.array(o) for o in fast["weights"](z, par))
     r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
+    J = np.reshape(J, (-1, z.size))
     A = -(np.diag(l.ravel()) + np.diag(np.ravel(b), -1)) @ J[: K - 1]   # d pred / d z
     excl = np.asarray(robust["excluded_readings"], int) - 1
     if robust["refit_without_outliers"]:  # information of the readings kept
