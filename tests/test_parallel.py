@@ -455,3 +455,11 @@ def test_progress_bar_on_a_terminal_is_tqdm():
     p(5)
     p.close()
     assert quiet.getvalue() == ""
+
+
+@pytest.mark.parametrize("value", ["abc", "", "-1", "nan", "inf", "0"])
+def test_a_bad_scheduler_timeout_is_one_line_before_any_work(monkeypatch, capsys, value):
+    monkeypatch.setenv("ZEROCAL_SCHEDULER_TIMEOUT", value)
+    assert main(["compare", "--trials", "2", "--quiet", "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "ZEROCAL_SCHEDULER_TIMEOUT" in err and "positive number" in err

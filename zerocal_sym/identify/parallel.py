@@ -63,12 +63,15 @@ def check_execution(workers=1, scheduler=None) -> int:
     Raises
     ------
     ZerocalError
-        ``workers`` < 1 or not an integer, or ``workers`` > 1 together with a scheduler.
+        ``workers`` < 1 or not an integer, or ``workers`` > 1 together with a scheduler, or a
+        scheduler address with a bad ``$ZEROCAL_SCHEDULER_TIMEOUT``.
     """
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
         raise ZerocalError(f"--workers must be a positive integer, got {workers!r}")
     if scheduler is not None and workers != 1:
         raise ZerocalError("give --workers N (local processes) or --scheduler ADDRESS (a Dask cluster), not both")
+    if isinstance(scheduler, str):
+        scheduler_timeout()  # a bad $ZEROCAL_SCHEDULER_TIMEOUT before any work
     return int(workers)
 
 
@@ -297,7 +300,7 @@ def dask_client(scheduler):
     if not isinstance(scheduler, str) or not scheduler.strip():
         raise ZerocalError(f"--scheduler: expected an address like tcp://host:8786, got {scheduler!r}")
     _check_address(scheduler)
-    timeout = float(os.environ.get("ZEROCAL_SCHEDULER_TIMEOUT", SCHEDULER_TIMEOUT_S))
+    timeout = scheduler_timeout()
     # Built in two steps to hold the client even when its constructor fails: one left half-open is closed
     # now (milliseconds), not by its __del__ at interpreter exit, which waits 20 s for an event loop that
     # has stopped and prints a TimeoutError traceback.
@@ -314,6 +317,22 @@ def dask_client(scheduler):
                                f"{msg}") from None
         raise ZerocalError(f"cannot connect to the Dask scheduler at {scheduler}: {msg}") from None
     return client, True
+
+
+def scheduler_timeout() -> float:
+    """Seconds to wait for a scheduler: ``$ZEROCAL_SCHEDULER_TIMEOUT`` (a positive number) or
+    :data:`SCHEDULER_TIMEOUT_S`."""
+    text = os.environ.get("ZEROCAL_SCHEDULER_TIMEOUT")
+    if text is None:
+        return SCHEDULER_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ZerocalError(f"ZEROCAL_SCHEDULER_TIMEOUT={text!r}: expected a positive number of seconds "
+                           f"(default {SCHEDULER_TIMEOUT_S:g})")
+    return value
 
 
 def _check_address(address: str) -> None:
