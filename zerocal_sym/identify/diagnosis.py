@@ -51,7 +51,7 @@ def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tupl
         if np.isfinite(p) and p >= alpha:
             causes.append({"cause": "constraints", "detected": True,
                            "text": " and ".join(what) + " contradict(s) the data",
-                           "evidence": f"without them chi2 = {c:.4g} on {d} dof (p = {_fmt_p(p)})"})
+                           "evidence": f"without them chi2 = {c:.4g} on {d} dof ({_fmt_p(p)})"})
         return causes, _paragraph(fit, causes, alpha, exact)
     if exact is not None:
         best = None
@@ -69,7 +69,7 @@ def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tupl
             key, text, c, p, d = best
             causes.append({"cause": "out of order" if key.startswith("swap") or key == "reversed" else key,
                            "detected": True, "text": text,
-                           "evidence": f"refitted so, chi2 = {c:.4g} on {d} dof (p = {_fmt_p(p)})"})
+                           "evidence": f"refitted so, chi2 = {c:.4g} on {d} dof ({_fmt_p(p)})"})
     # one bad reading: exact refits, each without one reading (from the prior: an outlier may have dragged
     # the estimate far along a weak direction, where the linearisation at the estimate says little)
     if exact is not None and dof >= 2 and not causes:
@@ -89,7 +89,7 @@ def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tupl
                 c, d = float(out["chi2"][j]), int(out["dof"][j])
                 text = (f"the reading at pose {k} (the change from pose {k - 1} to pose {k}) is off by about "
                         f"{e:+.3g} mm")
-                ev = f"without it chi2 = {c:.4g} on {d} dof (p = {_fmt_p(pk[j])})"
+                ev = f"without it chi2 = {c:.4g} on {d} dof ({_fmt_p(pk[j])})"
                 others = [i + 1 for i in ok if i != j]
                 if others:
                     ev += f"; without the reading at pose {', '.join(map(str, others))} instead it would fit too"
@@ -104,7 +104,7 @@ def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
     detected = [c for c in causes if c["detected"]]
     ratio = chi2 / dof if dof > 0 else float("inf")
     head = (f"The noise model rejects this fit: chi2 = {chi2:.4g} on {dof} degrees of freedom "
-            f"(p = {_fmt_p(fit['p_value'])} < {alpha:g}); the residuals are about {math.sqrt(ratio):.3g} times "
+            f"({_fmt_p(fit['p_value'])}, below {alpha:g}); the residuals are about {math.sqrt(ratio):.3g} times "
             "the noise the noise model states.")
     if detected:
         c = detected[0]
@@ -138,7 +138,7 @@ def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
 
 
 def _summary(fit: dict) -> str:
-    s = f"chi2 {fit['chi2']:.4g} on {fit['dof']} dof, p = {_fmt_p(fit['p_value'])} < {fit['alpha']:g}"
+    s = f"chi2 {fit['chi2']:.4g} on {fit['dof']} dof, {_fmt_p(fit['p_value'])}, below {fit['alpha']:g}"
     det = [c for c in fit.get("causes", []) if c.get("detected")]
     if det:
         s += f"; likely: {det[0]['text']}"
@@ -155,7 +155,7 @@ def finish(fit: dict, exact: _Exact | None, diagnose: bool = True, z_est=None) -
             fit["diagnosis"] = _diagnose(None, fit, fit["alpha"])[1]
     elif fit["checked"]:
         fit["diagnosis"] = (f"The fit agrees with the noise model: chi2 = {fit['chi2']:.4g} on {fit['dof']} dof "
-                            f"(p = {_fmt_p(fit['p_value'])}).")
+                            f"({_fmt_p(fit['p_value'])}).")
     else:
         fit["diagnosis"] = fit["reason"]
     fit.pop("_t", None)

@@ -142,9 +142,10 @@ def _noise_dict(noise) -> dict:
 
 
 def _fmt_p(p) -> str:
+    """``p = 0.0123``, ``p < 1e-300`` (below the smallest double the tail reaches) or ``p n/a``."""
     if p is None or not np.isfinite(p):
-        return "n/a"
-    return "< 1e-300" if p == 0.0 else f"{p:.3g}"
+        return "p n/a"
+    return "p < 1e-300" if p == 0.0 else f"p = {p:.3g}"
 
 
 def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
@@ -183,7 +184,7 @@ def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
         fit.update(checked=True, p_value=p, p_value_lower=pl, rejected=bool(p < alpha))
         if pl < alpha:
             fit["warnings"].append(
-                f"chi2 = {chi2:.4g} is far below its {dof} degrees of freedom (lower-tail p = {_fmt_p(pl)}): the "
+                f"chi2 = {chi2:.4g} is far below its {dof} degrees of freedom (lower-tail {_fmt_p(pl)}): the "
                 "noise model overstates the noise, so the standard deviations are too large (conservative)")
     n = lin.n
     tt = np.where(np.isfinite(t), t, np.nan).tolist()
