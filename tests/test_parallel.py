@@ -463,3 +463,12 @@ def test_a_bad_scheduler_timeout_is_one_line_before_any_work(monkeypatch, capsys
     assert main(["compare", "--trials", "2", "--quiet", "--scheduler", "tcp://127.0.0.1:1"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "ZEROCAL_SCHEDULER_TIMEOUT" in err and "positive number" in err
+
+
+def test_a_scheduler_without_workers_is_an_error_not_a_silent_wait(monkeypatch, capsys):
+    distributed = pytest.importorskip("dask.distributed")
+    monkeypatch.setenv("ZEROCAL_SCHEDULER_TIMEOUT", "0.5")
+    with distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp", dashboard_address=":0") as cluster:
+        assert main(["compare", "--trials", "2", "--quiet", "--scheduler", cluster.scheduler_address]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "has no workers" in err

@@ -335,6 +335,19 @@ def scheduler_timeout() -> float:
     return value
 
 
+def _require_workers(client, timeout: float) -> None:
+    """A scheduler without workers would take the chunks and never run them: wait ``timeout`` s for one,
+    then say so."""
+    try:
+        if client.scheduler_info().get("workers"):
+            return
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        raise ZerocalError(f"the Dask scheduler at {describe_scheduler(client)} has no workers (none joined "
+                           f"within {timeout:g} s): start some (dask worker ADDRESS) or use --workers N "
+                           "on this machine") from None
+
+
 def _check_address(address: str) -> None:
     """A malformed scheduler address is an error before anything is contacted (no timeout to wait for)."""
     from distributed.comm.addressing import parse_address
@@ -385,6 +398,7 @@ def _run_dask(fn, tasks, scheduler, finished):
     client, owned = dask_client(scheduler)
     futs = []
     try:
+        _require_workers(client, scheduler_timeout())
         futs = [client.submit(fn, t, pure=False) for t in tasks]
         index = {f.key: i for i, f in enumerate(futs)}
         for f in as_completed(futs, loop=client.loop):  # our client: never the default one
