@@ -130,7 +130,7 @@ def test_non_finite_theta_cmd_names_the_pose(robot, th6, R, no_work):
 def test_identify_nlls_refuses_non_finite_values_before_ipopt(robot, th6, R):
     m = Measurements(th6, R[0].copy())
     m.readings[[2, 5]] = np.nan
-    with pytest.raises(IdentificationError, match=r"^<memory>: readings must be finite: NaN or inf at pose\(s\) "
+    with pytest.raises(IdentificationError, match=r"^readings must be finite: NaN or inf at pose\(s\) "
                                                   r"2, 5$"):
         identify_nlls(robot, m)
     m = Measurements(th6.copy(), R[0])
@@ -172,3 +172,19 @@ def test_nonfinite_fail_leaves_those_data_sets_failed_and_the_rest_unchanged(rob
     assert allbad.estimate.shape == R.shape[:1] + (4,) and not allbad.success.any()
     with pytest.raises(ValueError, match="nonfinite must be"):
         identify_batch(robot, th6, R, noise="paper", nonfinite="skip")
+
+
+def test_identify_nlls_says_what_meas_must_be(robot, th6, R):
+    with pytest.raises(TypeError, match="Measurements"):
+        identify_nlls(robot, (th6, R[0]))
+    bad = R[0].copy()
+    bad[2] = np.nan
+    with pytest.raises(IdentificationError) as info:
+        identify_nlls(robot, Measurements(th6, bad))
+    assert not str(info.value).startswith("<memory>")  # an object in memory is not a file to name
+
+
+@pytest.mark.parametrize("scale, servo", [(-1.0, 1.0), (1.0, -0.5), (np.nan, 1.0), (1.0, np.inf)])
+def test_a_noise_model_is_finite_and_non_negative(scale, servo):
+    with pytest.raises(ValueError, match="finite standard deviation >= 0"):
+        NoiseModel.paper(scale, servo)

@@ -30,9 +30,13 @@ def check_measurements(robot, meas):
         NaN or inf (naming the poses, and the file's line when ``meas`` came
         from a file).
     """
+    if not (hasattr(meas, "theta_cmd") and hasattr(meas, "readings")):
+        raise TypeError(f"meas must be a Measurements(theta_cmd, readings) (zerocal_sym.model.measurements), got "
+                        f"{type(meas).__name__}")
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
     K = theta_cmd.shape[0]
     src = getattr(meas, "source", None)
+    src = None if src == "<memory>" else src  # (errors name a file, not an object in memory)
     if K < 2:
         raise IdentificationError(f"need at least 2 poses, got {K}")
     if theta_cmd.ndim != 2 or theta_cmd.shape[1] != robot.m:

@@ -49,6 +49,16 @@ class NoiseModel:
     sigma_scale_mm: float = 0.0
     sigma_servo_rad: float = 0.0
 
+    def __post_init__(self):
+        for name in ("sigma_scale_mm", "sigma_servo_rad"):
+            v = getattr(self, name)
+            try:
+                ok = bool(np.isfinite(v) and v >= 0)
+            except TypeError:
+                ok = False
+            if not ok:
+                raise ValueError(f"NoiseModel: {name} must be a finite standard deviation >= 0, got {v!r}")
+
     @classmethod
     def paper(cls, scale: float = 1.0, servo: float = 1.0) -> "NoiseModel":
         """The paper's noise, each term multiplied by a factor."""
