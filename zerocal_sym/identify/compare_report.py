@@ -46,7 +46,8 @@ def format_compare(rep: dict) -> str:
                              f"{_vec(q['q95'], '+10.4f'):>{w}s}")
         sr = go.get("scipy_reference")
         if sr:
-            lines.append(f"  scipy least_squares (lm) on the same problem: max |diff| to Ipopt "
+            lines.append(f"  scipy least_squares (lm) on Ipopt's problem with the weights held at the start "
+                         f"(identify_nlls reweight=0, not the nlls row): max |diff| to Ipopt "
                          f"{sr['max_abs_diff_to_ipopt_deg']:.2e} deg; time Ipopt {sr['time_ipopt_ms']:.2f} ms "
                          f"(whole identification) vs scipy {sr['time_scipy_ms']:.2f} ms (solver call): "
                          f"ratio {sr['time_ratio_ipopt_over_scipy']:.2f}")
