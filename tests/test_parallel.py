@@ -166,7 +166,8 @@ def test_scheduler_address_through_the_cli(tmp_path, capsys):
 
 MALFORMED = {"nonsense": "no port number", "tcp://localhost": "no port number",
              "http://localhost:8786": "unknown address scheme 'http://'", "bad:addr:x": "invalid address",
-             "tcp://localhost:99999": "port 99999 is out of range"}
+             "tcp://localhost:99999": "port 99999 is out of range", "tcp://:8799": "no host",
+             "tcp://127.0.0.1:8799/": "the port is not a number", "tcp://127.0.0.1:87a": "the port is not a number"}
 
 
 def test_malformed_scheduler_address_is_one_line_at_once(capsys):

@@ -370,7 +370,11 @@ def _check_address(address: str) -> None:
         why = str(exc).splitlines()[0] if str(exc) else "invalid address"
         if "missing port" in why:
             why = "no port number"
+        elif "invalid literal for int" in why:
+            why = "the port is not a number"
         raise ZerocalError(f"--scheduler {address}: {why} ({expected})") from None
+    if not _host:
+        raise ZerocalError(f"--scheduler {address}: no host ({expected})")
     if not 0 < int(port) < 65536:
         raise ZerocalError(f"--scheduler {address}: port {port} is out of range 1..65535 ({expected})")
 
