@@ -37,3 +37,21 @@ def test_a_burst_of_ctrl_c_does_not_hang_the_handler():
     # a KeyboardInterrupt may escape this harness between its try blocks (then the process ends by SIGINT,
     # -2); a hang, or any other error, is what must not happen
     assert proc.returncode in (0, -2) and "Error" not in proc.stderr, proc.stderr[-500:]
+
+
+def test_leaving_the_handler_wakes_its_thread(monkeypatch):
+    """close() wakes the re-trip thread (before, it waited its 1 s join timeout for nothing: every command
+    took a second longer)."""
+    from zerocal_sym.cli import _interrupt
+
+    made = []
+
+    class Spy(_interrupt._Redeliver):
+        def __init__(self):
+            super().__init__()
+            made.append(self)
+
+    monkeypatch.setattr(_interrupt, "_Redeliver", Spy)
+    with _interrupt.installed():
+        pass
+    assert len(made) == 1 and not made[0].thread.is_alive() and made[0].ended == "closed"

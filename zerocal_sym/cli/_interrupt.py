@@ -57,6 +57,7 @@ class _Redeliver:
     def __init__(self):
         self.lock = threading.Lock()
         self.closed = False
+        self.ended = None  # why the thread ended: "closed" (woken by close()) or "eof" (the pipe closed on it)
         self._r, self._w = os.pipe()
         self.thread = threading.Thread(target=self._run, name="zerocal-ctrl-c", daemon=True)
         self.thread.start()
@@ -65,10 +66,14 @@ class _Redeliver:
         try:
             while True:
                 try:
-                    os.read(self._r, 4096)  # a burst of Ctrl-C: one re-trip
+                    data = os.read(self._r, 4096)  # a burst of Ctrl-C: one re-trip
                 except OSError:
+                    data = b""
+                if not data:
+                    self.ended = "eof"
                     return
                 if self.closed:
+                    self.ended = "closed"
                     return
                 time.sleep(self.DELAY)
                 with self.lock:
@@ -95,7 +100,10 @@ class _Redeliver:
     def close(self):
         with self.lock:
             self.closed = True
-        self._kick()
+        try:
+            os.write(self._w, b"!")  # wake the thread: it sees closed and ends (not _kick: closed already)
+        except OSError:
+            pass
         self.thread.join(1.0)
         try:
             os.close(self._w)
