@@ -16,7 +16,8 @@ def execution(args) -> dict:
     one or a missing dask is an error now.  The returned scheduler is a
     connected ``dask.distributed.Client`` (close it with :func:`close`).
     """
-    from zerocal_sym.identify.parallel import check_execution, dask_client
+    from zerocal_sym.identify.dask_cluster import dask_client
+    from zerocal_sym.identify.parallel import check_execution
 
     workers = check_execution(args.workers, args.scheduler)
     if args.scheduler is None:

@@ -41,7 +41,8 @@ from zerocal_sym.errors import ZerocalError
 from zerocal_sym.cli.study_chunks import _CHUNK_RE, ChunkError, _cell_json, check_directory, chunk_path, read_chunk, write_chunk
 from zerocal_sym.cli.study_spec import Study, load_spec  # noqa: F401 - load_spec kept importable from here (benchmarks)
 from zerocal_sym.identify.one_shot import OneShotTask, one_shot_chunk
-from zerocal_sym.identify.parallel import chunk_ranges, describe_scheduler, run_chunks
+from zerocal_sym.identify.dask_cluster import describe_scheduler
+from zerocal_sym.identify.parallel import chunk_ranges, run_chunks
 from zerocal_sym.identify.stats import QUANTILES, Stats
 
 

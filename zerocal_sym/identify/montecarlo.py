@@ -44,8 +44,9 @@ from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
 from zerocal_sym.identify.loop import calibration_loop, calibration_loops, simulate_round
+from zerocal_sym.identify.dask_cluster import describe_scheduler
 from zerocal_sym.identify.parallel import (Progress, Stats, check_execution, chunk_ranges, default_chunk,
-                                          describe_scheduler, run_chunks)
+                                          run_chunks)
 from zerocal_sym.identify.compare_report import format_compare
 from zerocal_sym.identify.scipy_reference import least_squares_or_error, scipy_identify
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
