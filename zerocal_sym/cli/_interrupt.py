@@ -83,13 +83,15 @@ class _Redeliver:
         finally:
             os.close(self._r)
 
-    def _kick(self):
-        if self.closed:  # (set before the pipe is closed; the handler and close() share the main thread)
-            return
+    def _wake(self):
         try:
             os.write(self._w, b"!")
-        except OSError:  # closed: nothing to re-trip
+        except OSError:  # closed: nothing to wake
             pass
+
+    def _kick(self):
+        if not self.closed:  # (set before the pipe is closed; the handler and close() share the main thread)
+            self._wake()
 
     def handler(self, signum, frame):
         if is_interrupt(sys.exc_info()[1]):  # already on its way up: let the cleanup run
@@ -100,10 +102,7 @@ class _Redeliver:
     def close(self):
         with self.lock:
             self.closed = True
-        try:
-            os.write(self._w, b"!")  # wake the thread: it sees closed and ends (not _kick: closed already)
-        except OSError:
-            pass
+        self._wake()  # the thread sees closed and ends
         self.thread.join(1.0)
         try:
             os.close(self._w)

@@ -131,8 +131,6 @@ def run(args):
     return 0
 
 
-
-
 def _run(args, robot, use_table2, groups, truth, common):
     from zerocal_sym.identify import montecarlo
     from zerocal_sym.identify.montecarlo import Progress
