@@ -20,6 +20,7 @@ import numpy as np
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.nlls import identify_nlls, noise_terms
+from zerocal_sym.identify.nlls_inputs import index_list
 from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
 from zerocal_sym.identify.nlls_problem import GN_BLOCKS, get_problem
 from zerocal_sym.model.measurements import Measurements
@@ -93,13 +94,6 @@ def _gauss_newton_blocks(prob, z, P):
     return z.T, step, r, J
 
 
-def _indices(idx, limit: int = 10) -> str:
-    """``1, 4, 7`` (at most ``limit`` of them, then how many in all)."""
-    idx = [int(i) for i in idx]
-    more = f", ... ({len(idx)} in all)" if len(idx) > limit else ""
-    return ", ".join(map(str, idx[:limit])) + more
-
-
 def _check_inputs(robot, theta_cmd, readings, names):
     """``theta_cmd`` (K, m) and ``readings`` (N, K) as float arrays, or the error that says what is wrong where."""
     m = robot.m
@@ -126,14 +120,14 @@ def _check_inputs(robot, theta_cmd, readings, names):
     bad = ~np.isfinite(th)
     if bad.any():
         k = np.flatnonzero(bad.any(axis=1))
-        raise ValueError(f"theta_cmd must be finite: NaN or inf joint angles at pose(s) {_indices(k)} "
+        raise ValueError(f"theta_cmd must be finite: NaN or inf joint angles at pose(s) {index_list(k)} "
                          f"(theta_cmd[{k[0]}] = {th[k[0]].tolist()})")
     bad = ~np.isfinite(R)
     if bad.any():
         rows, poses = np.flatnonzero(bad.any(axis=1)), np.flatnonzero(bad.any(axis=0))
         i, k = np.argwhere(bad)[0]
         raise ValueError(f"readings must be finite: {int(bad.sum())} NaN or inf value(s) in data set(s) (row) "
-                         f"{_indices(rows)} at pose(s) (column) {_indices(poses)}; the first: readings[{i}, {k}] "
+                         f"{index_list(rows)} at pose(s) (column) {index_list(poses)}; the first: readings[{i}, {k}] "
                          f"= {R[i, k]}")
     return th, R
 

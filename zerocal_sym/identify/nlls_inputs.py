@@ -20,6 +20,13 @@ def _as_vector(x, n, what):
     return a
 
 
+def index_list(idx, limit: int = 10) -> str:
+    """``1, 4, 7`` (at most ``limit`` of them, then how many in all): poses or rows in an error message."""
+    idx = [int(i) for i in idx]
+    more = f", ... ({len(idx)} in all)" if len(idx) > limit else ""
+    return ", ".join(map(str, idx[:limit])) + more
+
+
 def check_measurements(robot, meas):
     """``theta_cmd`` (K, m) and ``readings`` (K,) of ``meas`` as float arrays.
 
@@ -50,8 +57,7 @@ def check_measurements(robot, meas):
     for what, a in (("theta_cmd (commanded joint angles)", theta_cmd), ("readings", readings)):
         bad = np.flatnonzero(~np.all(np.isfinite(a.reshape(K, -1)), axis=1))
         if bad.size:
-            raise IdentificationError(f"{what} must be finite: NaN or inf at pose(s) "
-                                      f"{', '.join(map(str, bad[:10]))}{', ...' if bad.size > 10 else ''}",
+            raise IdentificationError(f"{what} must be finite: NaN or inf at pose(s) {index_list(bad)}",
                                       where=meas.where(int(bad[0])) if getattr(meas, "lines", None) else src)
     return theta_cmd, readings
 
