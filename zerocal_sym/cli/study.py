@@ -38,7 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.cli.study_chunks import _CHUNK_RE, ChunkError, _cell_json, check_directory, chunk_path, read_chunk, write_chunk
+from zerocal_sym.cli.study_chunks import (_CHUNK_RE, ChunkError, _cell_json, check_directory, chunk_path, read_chunk,
+                                          write_chunk)
 from zerocal_sym.cli.study_spec import Study, load_spec  # noqa: F401 - load_spec kept importable from here (benchmarks)
 from zerocal_sym.identify.one_shot import OneShotTask, one_shot_chunk
 from zerocal_sym.identify.dask_cluster import describe_scheduler
@@ -61,10 +62,7 @@ def plan(study: Study, out) -> tuple:
     todo, done, bad = [], 0, []
     for cell in study.cells:
         digest = cell.digest(study)
-        try:
-            beyond_chunks(study, out, cell, digest)
-        except ChunkError as exc:
-            bad.append(exc)
+        bad += beyond_chunks(study, out, cell, digest)
         for k, (a, b) in enumerate(chunk_ranges(study.trials, study.chunk)):
             p = chunk_path(out, cell, k)
             try:
@@ -76,14 +74,19 @@ def plan(study: Study, out) -> tuple:
                 done += 1
             else:
                 todo.append((cell, k, a, b))
+    _refuse(bad)
+    return todo, done
+
+
+def _refuse(bad) -> None:
+    """Raise the first of the chunk files refused (``bad``, ChunkErrors), saying how many others there are."""
     if bad:
         n = len(bad) - 1
         more = f" ({n} other chunk file{'s are' if n > 1 else ' is'} refused too)" if n else ""
         raise ChunkError(bad[0].message + more, where=bad[0].where)
-    return todo, done
 
 
-def beyond_chunks(study: Study, out, cell, digest) -> int:
+def beyond_chunks(study: Study, out, cell, digest) -> list:
     """Check the chunk files of ``cell`` whose index is beyond its chunks (``chunk-<k>.npz``, ``k >= chunks``).
 
     Such a file is left by a run with more trials (it is read again if
@@ -92,33 +95,23 @@ def beyond_chunks(study: Study, out, cell, digest) -> int:
 
     Returns
     -------
-    int
-        How many there are.
-
-    Raises
-    ------
-    ChunkError
-        The first that does not belong (damaged, another cell's, other trials), with the number of others.
+    list of ChunkError
+        The files that do not belong (damaged, another cell's, other trials).
     """
     d = Path(out) / cell.id
     if not d.is_dir():
-        return 0
-    n, bad = 0, []
+        return []
+    bad = []
     for p in sorted(d.iterdir()):
         m = _CHUNK_RE.match(p.name)
         if not m or p.name != f"chunk-{int(m.group(1))}.npz" or int(m.group(1)) < study.chunks_per_cell:
             continue
         k = int(m.group(1))
-        n += 1
         try:
             read_chunk(p, cell.id, digest, cell.params, k * study.chunk, (k + 1) * study.chunk, columns=False)
         except ChunkError as exc:
             bad.append(exc)
-    if bad:
-        more = len(bad) - 1
-        raise ChunkError(bad[0].message + (f" ({more} other chunk file{'s are' if more > 1 else ' is'} refused too)"
-                                           if more else ""), where=bad[0].where)
-    return n
+    return bad
 
 
 def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None, log=None,
@@ -172,10 +165,10 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     t0 = time.perf_counter()
     if todo:  # the summary of an earlier run no longer describes the directory: gone before the first chunk
         (out / "summary.json").unlink(missing_ok=True)
-    for cell in study.cells:  # the cells to run, and those whose (unreadable) cell.json was deleted
-        if cell.id in {c.id for c, *_ in todo} or (out / cell.id).is_dir():
+    digests = {c.id: c.digest(study) for c, *_ in todo}  # the cells to run
+    for cell in study.cells:  # and those whose (unreadable) cell.json was deleted
+        if cell.id in digests or (out / cell.id).is_dir():
             _cell_json(out, cell, study)
-    digests = {c.id: c.digest(study) for c, *_ in todo}
     tasks = [OneShotTask(c.robot, c.theta, c.truth, c.noise, c.params, study.seed, c.stream, a, b)
              for c, k, a, b in todo]
 
@@ -228,7 +221,7 @@ def summarize(study: Study, out) -> dict:
     for cell in study.cells:
         _cell_json(out, cell, study, check_only=True)  # chunks of other settings are not merged
         digest = cell.digest(study)
-        beyond_chunks(study, out, cell, digest)  # not summarised, but refused if not the cell's
+        _refuse(beyond_chunks(study, out, cell, digest))  # not summarised, but refused if not the cell's
         errors = cell.robot.errors
         names = cell.params
         conv = np.array([math.degrees(1.0) if errors[n].unit == "rad" else 1.0 for n in names])

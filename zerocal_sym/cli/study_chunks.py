@@ -187,21 +187,22 @@ def _study_names(out: Path) -> tuple:
         if p.name.startswith(".") or not (p / "cell.json").is_file():
             continue
         cells.append(p.name)
-        try:
-            name = json.loads((p / "cell.json").read_text()).get("study")
-        except (OSError, ValueError, AttributeError):
-            name = None  # an unreadable cell.json is reported by _cell_json if the spec has the cell
-        if isinstance(name, str):
+        name = _recorded_study(p / "cell.json")  # (an unreadable cell.json: _cell_json reports it)
+        if name is not None:
             names.setdefault(name, f"{p.name}/cell.json")
-    s = out / "summary.json"
-    if s.is_file():
-        try:
-            name = json.loads(s.read_text()).get("study")
-        except (OSError, ValueError, AttributeError):
-            name = None
-        if isinstance(name, str):
-            names.setdefault(name, "summary.json")
+    name = _recorded_study(out / "summary.json")
+    if name is not None:
+        names.setdefault(name, "summary.json")
     return cells, names
+
+
+def _recorded_study(path):
+    """The study name a cell.json or summary.json records, or None (no file, unreadable, none recorded)."""
+    try:
+        name = json.loads(path.read_text()).get("study")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return name if isinstance(name, str) else None
 
 
 def check_directory(out, study, run: bool) -> None:
