@@ -279,6 +279,7 @@ def load_spec(path) -> Study:
         Naming the spec file and the line.
     """
     from zerocal_sym.cli._checks import identifiability_problem
+    from zerocal_sym.identify.montecarlo import offsets_missing
     from zerocal_sym.cli._common import parse_named_values
     from zerocal_sym.identify.fitcheck import DEFAULT_MAX_OFFSET_DEG
     from zerocal_sym.model import kinematics as kin
@@ -328,10 +329,9 @@ def load_spec(path) -> Study:
             names = robot.errors.resolve(params)
         except ValueError as exc:
             raise StudySpecError(f"params for robot {rl!r}: {exc}", where=where("params")) from None
-        offs = robot.errors.zero_offsets
-        if any(n not in names for n in offs):  # the words of compare's check (identify/montecarlo.py)
-            raise StudySpecError(f"params = {params!r} for robot {rl!r}: the parameter set must contain the zero "
-                                 f"offsets {', '.join(offs)}", where=where("params"))
+        missing = offsets_missing(robot.errors, names)  # compare's check
+        if missing:
+            raise StudySpecError(f"params = {params!r} for robot {rl!r}: {missing}", where=where("params"))
         for di, dt in enumerate(designs):
             def wd(key, _i=di):
                 return where(key, "design", _i)

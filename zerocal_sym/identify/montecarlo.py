@@ -223,6 +223,15 @@ def _compare_chunk(task: _CompareTask) -> dict:
             "scipy": {"diff": sc_diff, "t_sc": sc_t, "t_ip": ip_t}}
 
 
+def offsets_missing(errors, names) -> str | None:
+    """Why the parameter set ``names`` cannot serve a comparison of zero offsets (they are what it compares), or
+    None."""
+    offs = errors.zero_offsets
+    if any(n not in names for n in offs):
+        return f"the parameter set must contain the zero offsets {', '.join(offs)}"
+    return None
+
+
 def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise: NoiseModel | None = None,
             seed: int = 0, methods=METHODS, mu0_deg: float = 0.1, max_iter: int = 20,
             progress=None, report=None, settings=None, workers: int = 1, scheduler=None,
@@ -295,8 +304,9 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
         names = errors.resolve(params)
     except ValueError as exc:
         raise ZerocalError(str(exc)) from None
-    if any(n not in names for n in offs):
-        raise ZerocalError(f"the parameter set must contain the zero offsets {', '.join(offs)}")
+    missing = offsets_missing(errors, names)
+    if missing:
+        raise ZerocalError(missing)
     poses = np.atleast_2d(np.asarray(poses, float))
     th0 = kin.check_poses(robot, poses)
     K = poses.shape[0]
