@@ -88,21 +88,79 @@ def _free_symbols(exprs) -> set:
     return set().union(*(fs(e) for e in exprs))
 
 
+def _emit_exprs(lines, exprs, printer, prefix):
+    """CSE ``exprs`` into ``lines`` (locals ``<prefix>0, ...``); the reduced expressions."""
+    repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols(prefix))
+    for sym, expr in repl:
+        lines.append(f"    {printer.doprint(sym)} = {printer.doprint(expr)}")
+    return reduced
+
+
+def _emit_solve(lines, k, solve, printer):
+    """``X = ca.solve(A, B)`` of a :class:`~derivations.mechanism.LinearSolve`, its entries unpacked."""
+    A, B, X = solve.A, solve.B, solve.X
+    red = _emit_exprs(lines, list(A) + list(B), printer, f"a{k}_")
+    lines.append(_matrix_code(f"A{k}", sp.Matrix(A.rows, A.cols, red[:A.rows * A.cols]), printer))
+    lines.append(_matrix_code(f"B{k}", sp.Matrix(B.rows, B.cols, red[A.rows * A.cols:]), printer))
+    lines.append(f"    X{k} = ca.solve(A{k}, B{k})")
+    for i in range(X.rows):
+        for j in range(X.cols):
+            lines.append(f"    {printer.doprint(X[i, j])} = X{k}[{i}, {j}]")
+
+
+def _emit_newton(lines, newton):
+    """The body of a forward kinematics solved by Newton steps (``fk(theta, g)``)."""
+    lines += [
+        "    P = _fk_start(g)[0]",
+        f"    for _ in range({int(newton.iterations)}):",
+        "        f, f_P = _fk_residual(P, theta, g)",
+        "        P = P - ca.solve(f_P, f)",
+        "    f = _fk_residual(P, theta, g)[0]",
+        f"    ok = ca.mmax(ca.fabs(f)) <= {float(newton.tol)!r}",
+        "    P = ca.if_else(ok, P, ca.DM.nan(P.numel(), 1))",
+        "    return (P,)",
+    ]
+
+
+def _emit_compose(lines, compose, m):
+    """The exact distance composed of ``fk`` and ``measuring`` at the actual joints and geometry."""
+    th = [f"theta_cmd[{k}]" for k in range(m)]
+    lines.append("    g_act = [g[k] for k in range(g.numel())]")
+    for q, (offset, idx) in enumerate(compose):
+        if offset:
+            th[idx] = f"{th[idx]} + err[{q}]"
+        else:
+            lines.append(f"    g_act[{idx - m}] = g_act[{idx - m}] + err[{q}]")
+    lines += [
+        "    g_act = ca.vertcat(*g_act)",
+        f"    theta = ca.vertcat({', '.join(th)})",
+        "    P = _fk(theta, g_act)[0]",
+        "    return (_measuring(P, g_act)[0],)",
+    ]
+
+
 def emit_function(fname: str, spec: dict, printer) -> str:
     """Python source of ``_<fname>(inputs...)`` returning CasADi expressions."""
     args = [n for n, _ in spec["inputs"]]
     lines = [f"def _{fname}({', '.join(args)}):", f'    """{spec["doc"]}"""']
+    if "newton" in spec:
+        _emit_newton(lines, spec["newton"])
+        return "\n".join(lines)
+    if "compose" in spec:
+        _emit_compose(lines, spec["compose"], len(spec["inputs"][0][1]))
+        return "\n".join(lines)
     names = [n for n, _ in spec["outputs"]]
     mats = [m for _, m in spec["outputs"]]
     flat = [e for m in mats for e in m]
-    used = _free_symbols(flat)
+    solves = spec.get("solves", [])
+    used = _free_symbols(flat + [e for sv in solves for e in list(sv.A) + list(sv.B)])
     for argname, syms in spec["inputs"]:
         for k, s in enumerate(syms):
             if s in used:
                 lines.append(f"    {printer.doprint(s)} = {argname}[{k}]")
-    repl, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"))
-    for sym, expr in repl:
-        lines.append(f"    {printer.doprint(sym)} = {printer.doprint(expr)}")
+    for k, solve in enumerate(solves):
+        _emit_solve(lines, k, solve, printer)
+    reduced = _emit_exprs(lines, flat, printer, "t")
     pos = 0
     for name, m in zip(names, mats):
         n = m.rows * m.cols
@@ -117,6 +175,8 @@ def render(mech, sources) -> str:
     printer = CasadiPrinter({"fully_qualified_modules": True, "inline": True})
     src_names = ", ".join(_relative(p) for p in sorted(sources, key=_relative))
     geo_units = {str(s): mech.geometry_units.get(str(s), "mm") for s in mech.geometry}
+    pose_units = {str(s): mech.pose_units.get(str(s), "mm") for s in mech.pose}
+    home_pose = mech.home_pose if isinstance(mech.home_pose, (str, type(None))) else "home_pose"
     source_errors = [(e.name, e.role, e.unit, str(e.target), None if e.lever is None else str(e.lever))
                      for e in mech.source_errors]
     out = [
@@ -135,20 +195,28 @@ def render(mech, sources) -> str:
         f"JOINT_NAMES = {[str(s) for s in mech.joints]!r}",
         f"GEOMETRY_NAMES = {[str(s) for s in mech.geometry]!r}",
         f"GEOMETRY_UNITS = {geo_units!r}",
+        f"JOINT_KINDS = {list(mech.joint_kinds)!r}",
+        f"POSE_UNITS = {pose_units!r}",
         "#: (name, role, unit, target, lever arm) of each source error, in vector order",
         "SOURCE_ERRORS = [",
         *[f"    {row!r}," for row in source_errors],
         "]",
         f"SOURCE_ERROR_NAMES = {[e.name for e in mech.source_errors]!r}",
-        f"HOME_JOINTS = {[float(v) for v in mech.home_joints]!r}",
+        f"HOME_JOINTS = {None if mech.home_joints is None else [float(v) for v in mech.home_joints]!r}",
+        "#: None (HOME_JOINTS), 'workspace centre' or the name of the function giving the home pose",
+        f"HOME_POSE = {home_pose!r}",
         f"MEASURING_BASE = {[str(s) for s in mech.base_point]!r}",
         f"MEASURING_OFFSET = {[str(s) for s in mech.platform_offset]!r}",
         f"GAUGE_NAMES = {list(mech.gauge)!r}",
         f"GAUGE_FIX = {list(mech.gauge_fix)!r}",
         f"WORKSPACE = {mech.workspace!r}",
+        f"WORKSPACE_DEFAULTS = {mech.workspace_defaults!r}",
         f"ALIASES = {mech.aliases!r}",
+        f"LIST_ALIASES = {mech.list_aliases!r}",
         f"DEFAULTS = {mech.defaults!r}",
         f"PARAM_SETS = {mech.param_sets!r}",
+        f"DEFAULT_SET = {tuple(mech.default_set)!r}",
+        f"NOISE = {mech.noise!r}",
         f"POSITIVE = {list(mech.positive)!r}",
         "FUNCTION_SIGNATURES = {",
     ]
@@ -184,6 +252,8 @@ def render(mech, sources) -> str:
 MECHANISMS = {
     "planar_2dof": "derivations.mechanisms.planar_2dof",
     "delta_rotary": "derivations.mechanisms.delta_rotary",
+    "delta_linear": "derivations.mechanisms.delta_linear",
+    "hexapod": "derivations.mechanisms.hexapod",
 }
 
 

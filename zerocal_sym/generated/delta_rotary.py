@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 0f9d626faf28498e
+inputs hash: 73b3dd0cc1124b49
 sympy: 1.14.0
 """
 import casadi as ca
@@ -13,6 +13,8 @@ POSE_NAMES = ['x', 'y', 'z']
 JOINT_NAMES = ['theta1', 'theta2', 'theta3']
 GEOMETRY_NAMES = ['R1', 'R2', 'R3', 'phi1', 'phi2', 'phi3', 'z1', 'z2', 'z3', 'L1', 'L2', 'L3', 'l1', 'l2', 'l3', 'r', 'cx', 'cy', 'cz', 'dx', 'dy', 'dz']
 GEOMETRY_UNITS = {'R1': 'mm', 'R2': 'mm', 'R3': 'mm', 'phi1': 'rad', 'phi2': 'rad', 'phi3': 'rad', 'z1': 'mm', 'z2': 'mm', 'z3': 'mm', 'L1': 'mm', 'L2': 'mm', 'L3': 'mm', 'l1': 'mm', 'l2': 'mm', 'l3': 'mm', 'r': 'mm', 'cx': 'mm', 'cy': 'mm', 'cz': 'mm', 'dx': 'mm', 'dy': 'mm', 'dz': 'mm'}
+JOINT_KINDS = ['revolute', 'revolute', 'revolute']
+POSE_UNITS = {'x': 'mm', 'y': 'mm', 'z': 'mm'}
 #: (name, role, unit, target, lever arm) of each source error, in vector order
 SOURCE_ERRORS = [
     ('theta1', 'zero_offset', 'rad', 'theta1', 'L1'),
@@ -39,14 +41,20 @@ SOURCE_ERRORS = [
 ]
 SOURCE_ERROR_NAMES = ['theta1', 'theta2', 'theta3', 'R1', 'R2', 'R3', 'phi1', 'phi2', 'phi3', 'z1', 'z2', 'z3', 'L1', 'L2', 'L3', 'l1', 'l2', 'l3', 'rMx', 'rMy', 'rMz']
 HOME_JOINTS = [0.0, 0.0, 0.0]
+#: None (HOME_JOINTS), 'workspace centre' or the name of the function giving the home pose
+HOME_POSE = None
 MEASURING_BASE = ['cx', 'cy', 'cz']
 MEASURING_OFFSET = ['dx', 'dy', 'dz']
 GAUGE_NAMES = ['translation z', 'rotation about z']
 GAUGE_FIX = ['z1', 'phi1']
 WORKSPACE = 'cylinder'
+WORKSPACE_DEFAULTS = {}
 ALIASES = {'R': {'R1': 1.0, 'R2': 1.0, 'R3': 1.0}, 'L': {'L1': 1.0, 'L2': 1.0, 'L3': 1.0}, 'l': {'l1': 1.0, 'l2': 1.0, 'l3': 1.0}}
+LIST_ALIASES = {}
 DEFAULTS = {'phi1': 0.0, 'phi2': 120.0, 'phi3': 240.0, 'z1': 0.0, 'z2': 0.0, 'z3': 0.0}
 PARAM_SETS = {'lengths': ('L1', 'L2', 'L3', 'l1', 'l2', 'l3'), 'base': ('R1', 'R2', 'R3', 'phi1', 'phi2', 'phi3', 'z1', 'z2', 'z3')}
+DEFAULT_SET = ('theta1', 'theta2', 'theta3', 'rMx', 'rMy', 'rMz')
+NOISE = {}
 POSITIVE = ['R1', 'R2', 'R3', 'L1', 'L2', 'L3', 'l1', 'l2', 'l3', 'r']
 FUNCTION_SIGNATURES = {
     'ik': ([('P', 3), ('g', 22)], [('theta', (3, 1)), ('ratio', (3, 1))]),
@@ -641,7 +649,7 @@ def _pose_error_jacobian(P, theta, g):
 
 
 def _error_jacobian(P, theta, g):
-    """dP/d(lever_i dtheta_i): the zero offsets as lengths (paper Eq. 13 in n dimensions)."""
+    """dP/d(offsets as lengths: lever_i dtheta_i for a revolute joint, ds_i for a prismatic one) (paper Eq. 13 in n dimensions)."""
     x = P[0]
     y = P[1]
     z = P[2]
@@ -882,7 +890,7 @@ def _error_jacobian(P, theta, g):
 
 
 def _measuring(P, g):
-    """Nominal measuring-mechanism length |P - c - d| and its unit vector."""
+    """Nominal measuring-mechanism length |O2 - O1| and its unit vector."""
     x = P[0]
     y = P[1]
     z = P[2]
@@ -903,7 +911,7 @@ def _measuring(P, g):
 
 
 def _g_row(P, theta, g):
-    """Identification row g_k = lam_hat^T [J, -I] (paper Eq. 28)."""
+    """Identification row g_k = d rho / d(offsets as lengths, measuring errors) (paper Eq. 28: lam_hat^T [J, -I] for lambda = P - c - d)."""
     x = P[0]
     y = P[1]
     z = P[2]

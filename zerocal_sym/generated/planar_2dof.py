@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: 83d9eac02f563a8e
+inputs hash: 6365228bcf587146
 sympy: 1.14.0
 """
 import casadi as ca
@@ -13,6 +13,8 @@ POSE_NAMES = ['x', 'y']
 JOINT_NAMES = ['theta1', 'theta2']
 GEOMETRY_NAMES = ['e1x', 'e1y', 'e2x', 'e2y', 'L1', 'L2', 'l1', 'l2', 'cx', 'cy', 'dx', 'dy']
 GEOMETRY_UNITS = {'e1x': 'mm', 'e1y': 'mm', 'e2x': 'mm', 'e2y': 'mm', 'L1': 'mm', 'L2': 'mm', 'l1': 'mm', 'l2': 'mm', 'cx': 'mm', 'cy': 'mm', 'dx': 'mm', 'dy': 'mm'}
+JOINT_KINDS = ['revolute', 'revolute']
+POSE_UNITS = {'x': 'mm', 'y': 'mm'}
 #: (name, role, unit, target, lever arm) of each source error, in vector order
 SOURCE_ERRORS = [
     ('theta1', 'zero_offset', 'rad', 'theta1', 'L1'),
@@ -30,14 +32,20 @@ SOURCE_ERRORS = [
 ]
 SOURCE_ERROR_NAMES = ['theta1', 'theta2', 'e1x', 'e1y', 'e2x', 'e2y', 'L1', 'L2', 'l1', 'l2', 'rMx', 'rMy']
 HOME_JOINTS = [0.0, 3.141592653589793]
+#: None (HOME_JOINTS), 'workspace centre' or the name of the function giving the home pose
+HOME_POSE = None
 MEASURING_BASE = ['cx', 'cy']
 MEASURING_OFFSET = ['dx', 'dy']
 GAUGE_NAMES = ['translation x', 'translation y', 'rotation about O']
 GAUGE_FIX = ['e1x', 'e1y', 'e2y']
 WORKSPACE = 'rectangle'
+WORKSPACE_DEFAULTS = {}
 ALIASES = {'ex': {'e1x': 1.0, 'e2x': -1.0}, 'ey': {'e1y': 1.0, 'e2y': 1.0}, 'L': {'L1': 1.0, 'L2': 1.0}, 'l': {'l1': 1.0, 'l2': 1.0}}
+LIST_ALIASES = {}
 DEFAULTS = {}
 PARAM_SETS = {'lengths': ('L1', 'L2', 'l1', 'l2'), 'base': ('e1x', 'e1y', 'e2x', 'e2y')}
+DEFAULT_SET = ('theta1', 'theta2', 'rMx', 'rMy')
+NOISE = {}
 POSITIVE = ['L1', 'L2', 'l1', 'l2']
 FUNCTION_SIGNATURES = {
     'ik': ([('P', 2), ('g', 12)], [('theta', (2, 1)), ('ratio', (2, 1))]),
@@ -196,7 +204,7 @@ def _pose_error_jacobian(P, theta, g):
 
 
 def _error_jacobian(P, theta, g):
-    """dP/d(lever_i dtheta_i): the zero offsets as lengths (paper Eq. 13 in n dimensions)."""
+    """dP/d(offsets as lengths: lever_i dtheta_i for a revolute joint, ds_i for a prismatic one) (paper Eq. 13 in n dimensions)."""
     x = P[0]
     y = P[1]
     theta1 = theta[0]
@@ -235,7 +243,7 @@ def _error_jacobian(P, theta, g):
 
 
 def _measuring(P, g):
-    """Nominal measuring-mechanism length |P - c - d| and its unit vector."""
+    """Nominal measuring-mechanism length |O2 - O1| and its unit vector."""
     x = P[0]
     y = P[1]
     cx = g[8]
@@ -252,7 +260,7 @@ def _measuring(P, g):
 
 
 def _g_row(P, theta, g):
-    """Identification row g_k = lam_hat^T [J, -I] (paper Eq. 28)."""
+    """Identification row g_k = d rho / d(offsets as lengths, measuring errors) (paper Eq. 28: lam_hat^T [J, -I] for lambda = P - c - d)."""
     x = P[0]
     y = P[1]
     theta1 = theta[0]

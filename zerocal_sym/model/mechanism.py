@@ -1,45 +1,62 @@
 """Registry of mechanisms: a name -> its generated CasADi builders, checked on load.
 
-A mechanism is a derivation module (``derivations/mechanisms/<name>.py``) whose
-generated module ``zerocal_sym/generated/<name>.py`` exports its names, roles
-and shapes beside the CasADi builders.  :class:`Mechanism` loads that module
-and checks the contract (:data:`CONTRACT`): every function the numeric layers
-use is there with the sizes the names imply.  Adding a mechanism = a
-derivation module, a line in ``derivations.codegen.MECHANISMS`` and in
-:data:`REGISTRY`, and robot files that name it (``docs/new-mechanism.md``).
+A mechanism is a derivation module whose generated module exports its names,
+roles, units and shapes beside the CasADi builders.  :class:`Mechanism` loads
+that module and checks the contract (:data:`CONTRACT`): every function the
+numeric layers use is there with the sizes the names imply.
+
+Where a mechanism comes from (:func:`mechanism_module`):
+
+* the built-in ones (:data:`REGISTRY`, ``zerocal_sym/generated/<name>.py``);
+* an installed package's entry point in the group :data:`ENTRY_POINT_GROUP`
+  (``name = "package.generated_module"``);
+* a robot file's ``mechanism_module`` line (a ``.py`` file beside the robot
+  file, or a dotted module name), registered by :func:`register_mechanism`.
 
 Glossary of sizes: n pose coordinates, m actuated joints, G geometry entries,
-q source errors (r of them on the robot, n on the measuring mechanism),
-s singularity indicators, z gauge motions.
+q source errors (r of them on the robot, u on the measuring mechanism),
+l the measuring vector's dimension, s singularity indicators, z gauge motions.
 """
 from __future__ import annotations
 
 import importlib
+import importlib.util
+import sys
 from functools import lru_cache
+from pathlib import Path
 
 from zerocal_sym.model.source_errors import SourceErrors
+from zerocal_sym.model.units import JOINT_KINDS, UNIT_OF_KIND
 
 REGISTRY = {
     "planar_2dof": "zerocal_sym.generated.planar_2dof",
     "delta_rotary": "zerocal_sym.generated.delta_rotary",
+    "delta_linear": "zerocal_sym.generated.delta_linear",
+    "hexapod": "zerocal_sym.generated.hexapod",
 }
 DEFAULT_MECHANISM = "planar_2dof"
+#: the entry-point group of installed packages' mechanisms (name -> generated module)
+ENTRY_POINT_GROUP = "zerocal_sym.mechanisms"
+#: mechanisms registered at run time (:func:`register_mechanism`): name -> module name or .py path
+_EXTERNAL = {}
 
 
 class MechanismContractError(Exception):
     """A generated module that does not fulfil the mechanism contract (a developer error)."""
 
 
-def _contract(n, m, G, q, r, z):
+def _contract(n, m, G, q, r, z, l=None, u=None):
     """Function name -> (input sizes, output shapes) implied by the sizes."""
+    l = n if l is None else l
+    u = n if u is None else u
     return {
         "ik": ([n, G], [(m, 1), (m, 1)]),
         "fk": ([m, G], [(n, 1)]),
         "transmission": ([n, m, G], None),
         "pose_error_jacobian": ([n, m, G], [(n, r)]),
         "error_jacobian": ([n, m, G], [(n, m)]),
-        "measuring": ([n, G], [(1, 1), (n, 1)]),
-        "g_row": ([n, m, G], [(1, m + n)]),
+        "measuring": ([n, G], [(1, 1), (l, 1)]),
+        "g_row": ([n, m, G], [(1, m + u)]),
         "distance": ([m, G, q], [(1, 1)]),
         "gauge": ([G], [(q, z)]),
     }
@@ -47,6 +64,50 @@ def _contract(n, m, G, q, r, z):
 
 #: The function names every mechanism provides.
 CONTRACT = tuple(_contract(0, 0, 0, 0, 0, 0))
+
+
+def _entry_points() -> dict:
+    """Installed packages' mechanisms: name -> module (the :data:`ENTRY_POINT_GROUP` entry points)."""
+    from importlib.metadata import entry_points
+
+    return {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def known_mechanisms() -> dict:
+    """Every mechanism that can be loaded now: name -> its generated module (name or path)."""
+    return {**_entry_points(), **_EXTERNAL, **REGISTRY}
+
+
+def register_mechanism(name: str, module) -> None:
+    """Make the generated module ``module`` (a dotted name, or a path to a ``.py`` file) mechanism ``name``.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is a built-in mechanism, or already registered from another module.
+    """
+    module = str(Path(module).resolve()) if str(module).endswith(".py") else str(module)
+    if name in REGISTRY and REGISTRY[name] != module:
+        raise ValueError(f"mechanism {name!r} is built in; name yours otherwise")
+    if _EXTERNAL.get(name, module) != module:
+        raise ValueError(f"mechanism {name!r} is registered already (from {_EXTERNAL[name]})")
+    _EXTERNAL[name] = module
+
+
+def _import(module: str):
+    """The generated module: a dotted name, or a ``.py`` file (imported under a private name)."""
+    if not module.endswith(".py"):
+        return importlib.import_module(module)
+    key = "zerocal_sym._external." + Path(module).stem
+    if key in sys.modules and getattr(sys.modules[key], "__file__", None) == module:
+        return sys.modules[key]
+    spec = importlib.util.spec_from_file_location(key, module)
+    if spec is None:
+        raise MechanismContractError(f"cannot import a mechanism from {module}")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[key] = mod
+    spec.loader.exec_module(mod)
+    return mod
 
 
 class Mechanism:
@@ -75,11 +136,14 @@ class Mechanism:
     """
 
     def __init__(self, name: str):
-        if name not in REGISTRY:
+        known = known_mechanisms()
+        if name not in known:
             raise KeyError(name)
         import numpy as np
 
-        mod = importlib.import_module(REGISTRY[name])
+        mod = _import(known[name])
+        if getattr(mod, "NAME", name) != name:
+            raise MechanismContractError(f"mechanism {name!r}: its module {known[name]} is mechanism {mod.NAME!r}")
         self.name = name
         self.module = mod
         self.description = mod.DESCRIPTION
@@ -92,7 +156,15 @@ class Mechanism:
         self.errors = SourceErrors(mod.SOURCE_ERRORS, {
             **mod.PARAM_SETS, "gauge_fixed": tuple(n for n in names if n not in mod.GAUGE_FIX)})
         self.source_error_names = list(self.errors.names)
-        self.home_joints = np.array(mod.HOME_JOINTS, float)
+        self.joint_kinds = list(getattr(mod, "JOINT_KINDS", ["revolute"] * len(self.joint_names)))
+        self.pose_units = dict(getattr(mod, "POSE_UNITS", {p: "mm" for p in self.pose_names}))
+        home = getattr(mod, "HOME_JOINTS", None)
+        self.home_joints = None if home is None else np.array(home, float)
+        self.home_pose_rule = getattr(mod, "HOME_POSE", None)
+        self.default_set = tuple(getattr(mod, "DEFAULT_SET", ())) or tuple(
+            n for n in names if self.errors[n].role in ("zero_offset", "measuring"))
+        self.workspace_defaults = dict(getattr(mod, "WORKSPACE_DEFAULTS", {}))
+        self.noise_defaults = dict(getattr(mod, "NOISE", {}))
         self.measuring_base = list(mod.MEASURING_BASE)
         self.measuring_offset = list(mod.MEASURING_OFFSET)
         self.gauge_names = list(mod.GAUGE_NAMES)
@@ -104,6 +176,27 @@ class Mechanism:
         self.n, self.m = len(self.pose_names), len(self.joint_names)
         self.functions = mod.build_functions()
         self.check()
+
+    # ------------------------------------------------------------------ units
+    @property
+    def joint_kind(self) -> str:
+        """The kind of every actuated joint (``revolute`` | ``prismatic``)."""
+        return self.joint_kinds[0]
+
+    @property
+    def joint_unit(self) -> str:
+        """Internal unit of the joints and their zero offsets: ``rad`` | ``mm``."""
+        return JOINT_KINDS[self.joint_kind]
+
+    @property
+    def joint_user_unit(self) -> str:
+        """The joints' unit in files and on the command line: ``deg`` | ``mm``."""
+        return UNIT_OF_KIND[self.joint_kind]
+
+    @property
+    def measuring_dim(self) -> int:
+        """l: the dimension of the measuring vector (2 or 3)."""
+        return len(self.measuring_base)
 
     def check(self) -> None:
         """Check the generated module against the contract.
@@ -121,16 +214,30 @@ class Mechanism:
         r = q - len(e.measuring)
         if len(e.zero_offsets) != m or [e[x].target for x in e.zero_offsets] != self.joint_names:
             fail("one zero offset per actuated joint, in joint order")
-        if [e[x].target for x in e.measuring] != self.measuring_base or len(self.measuring_base) != n:
-            fail("one measuring-mechanism error per pose coordinate, carried on the base point")
+        if len(self.joint_kinds) != m or not set(self.joint_kinds) <= set(JOINT_KINDS) or len(set(self.joint_kinds)) > 1:
+            fail(f"JOINT_KINDS must give one kind ({', '.join(JOINT_KINDS)}) shared by the {m} joints")
+        if any(e[x].unit != JOINT_KINDS[k] for x, k in zip(e.zero_offsets, self.joint_kinds)):
+            fail("a zero offset has its joint kind's unit (rad for revolute, mm for prismatic)")
+        if not set(e[x].target for x in e.measuring) <= set(self.measuring_base) | set(self.measuring_offset):
+            fail("measuring-mechanism errors are carried on the base point c or the platform point d")
+        if len(self.measuring_offset) != len(self.measuring_base) or len(self.measuring_base) not in (2, 3):
+            fail("the measuring points c and d have 2 or 3 coordinates each")
+        if not set(self.default_set) <= set(e.zero_offsets) | set(e.measuring) or not set(e.zero_offsets) <= set(
+                self.default_set):
+            fail("DEFAULT_SET: every zero offset, and measuring errors only")
         for err in e:
             if err.role == "geometry" and err.target not in self.geometry_names:
                 fail(f"source error {err.name!r} targets unknown geometry {err.target!r}")
             if (err.unit == "rad") != (err.lever is not None) or (err.lever and err.lever not in self.geometry_names):
                 fail(f"source error {err.name!r}: an angle needs a lever arm in the geometry, a length none")
-        if self.home_joints.shape != (m,):
+        if (self.home_joints is None) == (self.home_pose_rule is None):
+            fail("HOME_JOINTS or HOME_POSE, one of them")
+        if self.home_joints is not None and self.home_joints.shape != (m,):
             fail("HOME_JOINTS must have one entry per joint")
-        for fname, (ins, outs) in _contract(n, m, G, q, r, len(self.gauge_names)).items():
+        if self.home_pose_rule not in (None, "workspace centre") and self.home_pose_rule not in self.functions:
+            fail(f"HOME_POSE names a function {self.home_pose_rule!r} the module lacks")
+        contract = _contract(n, m, G, q, r, len(self.gauge_names), len(self.measuring_base), len(e.measuring))
+        for fname, (ins, outs) in contract.items():
             f = self.functions.get(fname)
             if f is None:
                 fail(f"missing function {fname!r}")

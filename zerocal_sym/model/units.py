@@ -1,0 +1,102 @@
+"""Units: the one place that turns internal values into file and command-line values and back.
+
+Inside, every angle is in rad and every length in mm.  Files, tables and the
+command line carry angles in degrees and lengths in mm, and every key, column
+or option that carries a value names its unit (``theta1_deg``, ``s1_mm``,
+``zero_offsets_deg``, ``zero_offsets_mm``).  The unit comes from the kind of
+the quantity -- a joint's kind (:data:`JOINT_KINDS`), a source error's or a
+pose coordinate's unit -- never from its name.
+
+Joint kinds
+-----------
+``revolute``
+    the joint variable is an angle: rad inside, degrees outside;
+``prismatic``
+    the joint variable is a length: mm inside and outside.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: joint kind -> internal unit of the joint variable (and of its zero offset)
+JOINT_KINDS = {"revolute": "rad", "prismatic": "mm"}
+#: internal unit -> the unit files and the command line use
+USER_UNIT = {"rad": "deg", "mm": "mm"}
+#: joint kind -> the unit files and the command line use
+UNIT_OF_KIND = {kind: USER_UNIT[unit] for kind, unit in JOINT_KINDS.items()}
+
+
+def to_user(value, unit: str):
+    """``value`` (internal ``unit``: rad or mm) in file units (deg or mm); arrays kept as arrays."""
+    if unit == "rad":
+        return np.degrees(value)
+    if unit == "mm":
+        return value
+    raise ValueError(f"unknown unit {unit!r}")
+
+
+def from_user(value, unit: str):
+    """``value`` in file units (deg or mm) in the internal ``unit`` (rad or mm)."""
+    if unit == "rad":
+        return np.radians(value)
+    if unit == "mm":
+        return value
+    raise ValueError(f"unknown unit {unit!r}")
+
+
+def user_unit(unit: str) -> str:
+    """The file unit of an internal unit: ``deg`` for ``rad``, ``mm`` for ``mm``."""
+    return USER_UNIT[unit]
+
+
+def key(stem: str, unit: str) -> str:
+    """``<stem>_<file unit>`` of a value in the internal ``unit``: ``key("zero_offsets", "rad")`` is
+    ``zero_offsets_deg``."""
+    return f"{stem}_{USER_UNIT[unit]}"
+
+
+def joint_key(mech, stem: str) -> str:
+    """``<stem>_deg`` or ``<stem>_mm`` after the mechanism's joint kind (``mech``: a Mechanism or Robot)."""
+    mech = getattr(mech, "mechanism", mech)
+    return key(stem, mech.joint_unit)
+
+
+def joints_to_user(mech, values):
+    """Joint values (or zero offsets) in file units, shape kept."""
+    return to_user(np.asarray(values, float), getattr(mech, "mechanism", mech).joint_unit)
+
+
+def joints_from_user(mech, values):
+    """Joint values (or zero offsets) from file units to internal units, shape kept."""
+    return from_user(np.asarray(values, float), getattr(mech, "mechanism", mech).joint_unit)
+
+
+def joint_unit(mech) -> str:
+    """The joints' file unit (``deg`` | ``mm``)."""
+    return getattr(mech, "mechanism", mech).joint_user_unit
+
+
+def pose_to_user(mech, P):
+    """Poses (shape (..., n)) in file units: orientation coordinates in degrees."""
+    mech = getattr(mech, "mechanism", mech)
+    P = np.array(P, float)
+    for i, name in enumerate(mech.pose_names):
+        if mech.pose_units.get(name, "mm") == "rad":
+            P[..., i] = np.degrees(P[..., i])
+    return P
+
+
+def pose_from_user(mech, P):
+    """Poses (shape (..., n)) from file units (degrees for orientations) to internal units."""
+    mech = getattr(mech, "mechanism", mech)
+    P = np.array(P, float)
+    for i, name in enumerate(mech.pose_names):
+        if mech.pose_units.get(name, "mm") == "rad":
+            P[..., i] = np.radians(P[..., i])
+    return P
+
+
+def pose_unit(mech, name: str) -> str:
+    """File unit of the pose coordinate ``name`` (``mm`` | ``deg``)."""
+    mech = getattr(mech, "mechanism", mech)
+    return USER_UNIT[mech.pose_units.get(name, "mm")]
