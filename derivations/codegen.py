@@ -97,8 +97,14 @@ def _emit_exprs(lines, exprs, printer, prefix):
 
 
 def _emit_solve(lines, k, solve, printer):
-    """``X = ca.solve(A, B)`` of a :class:`~derivations.mechanism.LinearSolve`, its entries unpacked."""
+    """``X = ca.solve(A, B)`` of a :class:`~derivations.mechanism.LinearSolve` (``X = ca.det(A)`` of a
+    :class:`~derivations.mechanism.Determinant`), its entries unpacked."""
     A, B, X = solve.A, solve.B, solve.X
+    if not B.rows:
+        red = _emit_exprs(lines, list(A), printer, f"a{k}_")
+        lines.append(_matrix_code(f"A{k}", sp.Matrix(A.rows, A.cols, red), printer))
+        lines.append(f"    {printer.doprint(X[0, 0])} = ca.det(A{k})")
+        return
     red = _emit_exprs(lines, list(A) + list(B), printer, f"a{k}_")
     lines.append(_matrix_code(f"A{k}", sp.Matrix(A.rows, A.cols, red[:A.rows * A.cols]), printer))
     lines.append(_matrix_code(f"B{k}", sp.Matrix(B.rows, B.cols, red[A.rows * A.cols:]), printer))

@@ -189,6 +189,8 @@ class SymbolicMechanism:
     gauge_fix : tuple of str
         Source errors held at zero to fix the gauge (one per gauge motion):
         the rest of ``all`` is identifiable from enough poses.
+    transmission_solves : tuple of Determinant or LinearSolve
+        Numeric steps the singularity indicators use (their symbols stand in ``transmission``).
     jacobian_form : str
         ``adjugate`` (closed-form ``-adj(df/dP) df/dq / det``, small n) or
         ``solve`` (``-(df/dP)^-1 df/dq`` solved by CasADi: six-DOF platforms).
@@ -229,6 +231,7 @@ class SymbolicMechanism:
     positive: tuple = ()
     gauge_fix: tuple = ()
     jacobian_form: str = "adjugate"
+    transmission_solves: tuple = ()
     noise: dict = field(default_factory=dict)
     extra_outputs: dict = field(default_factory=dict)
     outputs: dict = field(default_factory=dict)
@@ -355,6 +358,28 @@ class LinearSolve:
     B: sp.Matrix
 
 
+@dataclass(frozen=True)
+class Determinant:
+    """``X = det(A)`` (X a 1 x 1 Matrix of a symbol), evaluated numerically by CasADi inside a generated function
+    (a 6 x 6 symbolic determinant is out of reach of sympy's printing)."""
+
+    X: sp.Matrix
+    A: sp.Matrix
+
+    @property
+    def B(self):
+        return sp.zeros(0, 0)
+
+
+def numeric_value(solve, A, B):
+    """The value of a :class:`LinearSolve` or :class:`Determinant` for numeric ``A`` and ``B`` (for tests)."""
+    import numpy as np
+
+    if isinstance(solve, Determinant):
+        return np.array([[np.linalg.det(A)]])
+    return np.linalg.solve(A, B)
+
+
 def measuring_vector(mech: SymbolicMechanism):
     """The nominal measuring-mechanism vector ``O2 - O1`` (default ``lambda = P - c - d``)."""
     return mech.measuring_vector
@@ -434,6 +459,7 @@ def derive(mech: SymbolicMechanism) -> SymbolicMechanism:
                         outputs=[("rho", sp.Matrix([_norm(lam_actual)]))], doc=distance_doc)
     outputs.update({
         "transmission": dict(inputs=[Pin, Tin, Gin], outputs=[("s", mech.transmission)],
+                             solves=list(mech.transmission_solves),
                              doc="Singularity indicators: |s| >= margin away from a singular configuration."),
         "pose_error_jacobian": dict(
             inputs=[Pin, Tin, Gin], outputs=[("J_src", J_src)], solves=solves,

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from derivations.mechanism import FkSolve, SourceError, SymbolicMechanism, derive
+from derivations.mechanism import Determinant, FkSolve, SourceError, SymbolicMechanism, derive
 
 LEGS = (1, 2, 3, 4, 5, 6)
 #: the rotation columns of the singularity indicator's matrix are scaled by this length (mm)
@@ -93,9 +93,10 @@ def build() -> SymbolicMechanism:
     ik = sp.Matrix([_norm(w) for w in legs])
     ratio = sp.Matrix([(ik[i] - home_length[i]) / stroke for i in range(6)])
 
-    M = _leg_matrix(P, Rot, B, p)
-    M_home = _leg_matrix(P_home, sp.eye(3), B, p)
-    trans = sp.Matrix([M.det(method="berkowitz") / M_home.det(method="berkowitz")])
+    det, det_home = sp.Symbol("det_M", real=True), sp.Symbol("det_M_home", real=True)
+    dets = (Determinant(sp.Matrix([det]), _leg_matrix(P, Rot, B, p)),
+            Determinant(sp.Matrix([det_home]), _leg_matrix(P_home, sp.eye(3), B, p)))
+    trans = sp.Matrix([det / det_home])
 
     offsets = [SourceError(f"L{k}", L[k - 1], "zero_offset", "mm") for k in LEGS]
     geo_err = ([SourceError(str(v), v, "geometry", "mm") for bi in b for v in bi]
@@ -138,6 +139,7 @@ def build() -> SymbolicMechanism:
         ratio=ratio,
         fk=FkSolve(start=home, iterations=10, tol=1e-6),
         transmission=trans,
+        transmission_solves=dets,
         home_joints=None,
         home_pose=home,
         base_point=c,
@@ -155,7 +157,8 @@ def build() -> SymbolicMechanism:
                     "platform": tuple(str(v) for qi in q for v in qi),
                     "rM": ("rMx", "rMy", "rMz"), "dd": ("ddx", "ddy", "ddz")},
         positive=("Rb", "Rp", "z_home", "stroke"),
-        gauge_fix=("b1x", "b1y", "b1z", "b2x", "b2y", "b3z", "q1x", "q1y", "q1z", "q2x", "q2y", "q3z"),
+        # 3-2-1 on each side: three heights (t_z, w_x, w_y), then x, y of joint 1 and x of joint 2 (t_x, t_y, w_z)
+        gauge_fix=("b1x", "b1y", "b1z", "b2x", "b2z", "b3z", "q1x", "q1y", "q1z", "q2x", "q2z", "q3z"),
         noise={"scale": 0.001, "joint": 0.002},
     )
     return derive(mech)

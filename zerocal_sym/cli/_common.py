@@ -26,7 +26,7 @@ def scheme_names() -> tuple:
 
 def n_params(robot) -> int:
     """p = m + n: the paper's identification parameters (zero offsets and MAEMM)."""
-    return len(robot.errors.resolve("offsets+measuring"))
+    return len(robot.errors.resolve("default"))
 
 
 def min_n(robot) -> int:
@@ -119,7 +119,7 @@ def check_round_poses(robot, P, theta_cmd, source: str) -> None:
     from zerocal_sym.model import kinematics as kin
 
     K, p = len(P), n_params(robot)
-    names = ", ".join(robot.errors.resolve("offsets+measuring"))
+    names = ", ".join(robot.errors.resolve("default"))
     need = max(MIN_POSES, p + 1)
     why = "identify would refuse this measurement round"
     if K < need:

@@ -74,7 +74,7 @@ def run(args, robot):
         "joint_names": list(mech.joint_names),
         "poses": P.tolist(),
         "joints_deg": np.degrees(theta).tolist(),
-        "params": list(errors.resolve("offsets+measuring")),
+        "params": list(errors.resolve("default")),
         "kappa_1": k1,
         "kappa_1_note": "condition number of the paper's G (Eq. 28; offsets as L_i dtheta_i and MAEMM in mm), "
                         "no MAEMM prior",

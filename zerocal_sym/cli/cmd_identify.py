@@ -232,7 +232,7 @@ def run(args):
         if args.params != "paper" or args.prior_std or args.bound or args.max_iter is not None:
             raise ZerocalError("--params, --prior-std, --bound and --max-iter are for --method nlls "
                                "(tsvd identifies the zero offsets and the MAEMM)")
-        names = errors.resolve("offsets+measuring")
+        names = errors.resolve("default")
         if args.truncation is not None and not 1 <= args.truncation <= len(names):
             raise ZerocalError(f"--truncation must be 1..{len(names)} (the parameters {', '.join(names)})")
         from zerocal_sym.identify.tsvd import identify_tsvd

@@ -156,7 +156,7 @@ class ApproxDesign:
         """``d(x) / s`` of the measure at new poses: a function of ``X`` (M, n) -> (M,) (1 on the support)."""
         from zerocal_sym.model.noise import NoiseModel
 
-        noise = noise or NoiseModel.paper()
+        noise = NoiseModel.coerce(noise, robot=robot)
         crit = "crlb" if self.criterion == "mse" else self.criterion  # mse: the variance part's sensitivity
         wts = Weights(robot)
         m0 = PoseModel(robot, self.X, noise, crit, wts)
@@ -284,7 +284,7 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     if criterion not in APPROX_CRITERIA:
         raise DesignError(f"criterion {criterion!r} has no approximate design (known: {', '.join(APPROX_CRITERIA)}; "
                           "cond is not concave, mse not convex)")
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     cons = cons or make_constraints(robot)
     wts = _criterion_weights(robot, criterion, tolerances) if criterion == "position" else Weights(robot, tolerances)
     X, h = candidate_poses(robot, cons, n_candidates)

@@ -318,7 +318,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     from zerocal_sym.identify.linear import condition_number, identification_matrix
 
     P = np.atleast_2d(np.asarray(P, float))
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     table = criteria_table(robot)
     vals = criterion_values(robot, P, noise, tolerances)
     t = pose_terms(robot, P)

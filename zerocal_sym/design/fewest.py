@@ -55,7 +55,7 @@ def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, nois
         raise DesignError(f"the target CRLB must be a number of degrees, got {target_deg!r}") from None
     if not (math.isfinite(target) and target > 0):
         raise DesignError(f"the target CRLB must be positive and finite, got {target_deg!r} deg")
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     cons = cons or make_constraints(robot)
     k_max = MAX_K if k_max is None else int(k_max)
     ad = ad or approximate_design(robot, "crlb", cons, noise)

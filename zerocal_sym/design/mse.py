@@ -69,7 +69,7 @@ def mse_measure(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None
     """
     from zerocal_sym.model.noise import NoiseModel
 
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     X = ad.X
     Gt, Go, wd, model = _mse_terms(robot, X, noise, tolerances)
     w = np.maximum(ad.w, 0) + 1e-6 / len(ad.w)

@@ -323,7 +323,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     if method == "exact" and K > MAX_K_EXACT:
         raise DesignError(f"K = {K} is too large for the exact method (at most {MAX_K_EXACT}; the approximate "
                           "method takes any K)")
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     _noise_terms(noise)
     cons = cons or make_constraints(robot)
     timing = {}

@@ -180,7 +180,7 @@ def realize(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None, no
     """
     from zerocal_sym.model.noise import NoiseModel
 
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     cons = cons or make_constraints(robot)
     criterion = criterion or ad.criterion
     reps, ws = ad.support, ad.support_w

@@ -93,7 +93,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         raise DesignError(f"the number of Monte Carlo trials must be a positive integer, got {n_trials!r}")
     t0 = time.perf_counter()
     errors = robot.errors
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     if err_true is None:
         err = default_true_errors(robot)
     elif isinstance(err_true, dict):

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_linear.py
-inputs hash: 960a11e6449cd36d
+inputs hash: 7c9603421cd3db54
 sympy: 1.14.0
 """
 import casadi as ca

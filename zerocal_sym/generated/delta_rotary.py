@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 73b3dd0cc1124b49
+inputs hash: 54452a63d5c48cf5
 sympy: 1.14.0
 """
 import casadi as ca

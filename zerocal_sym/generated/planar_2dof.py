@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: 6365228bcf587146
+inputs hash: 70802b43d71d2259
 sympy: 1.14.0
 """
 import casadi as ca

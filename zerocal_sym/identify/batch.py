@@ -174,7 +174,7 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
         Fewer measured changes (K - 1) than parameters: without a Gaussian
         prior every data set would be rank deficient (as the CLI refuses).
     """
-    noise = NoiseModel.coerce(noise)
+    noise = NoiseModel.coerce(noise, robot=robot)
     errors = robot.errors
     names = errors.resolve(params)
     if nonfinite not in ("raise", "fail"):

@@ -204,7 +204,7 @@ def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None 
     names : tuple of str
         The omitted errors (columns).
     """
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     from zerocal_sym.identify import fisher
 
     errors = robot.errors

@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model import units
 from zerocal_sym.errors import PoseError
 from zerocal_sym.model.noise import NoiseModel
 
@@ -242,7 +243,7 @@ def fisher_information(robot, theta_cmd, params="paper", noise: NoiseModel | Non
     prior_std : ndarray, shape (p,), optional
         Gaussian prior std per parameter (rad / mm); ``inf`` for none.
     """
-    noise = noise or NoiseModel.paper()
+    noise = NoiseModel.coerce(noise, robot=robot)
     A = sensitivity(robot, theta_cmd, params, err0)
     C = change_covariance(robot, theta_cmd, noise, err0)
     if C.is_zero:
@@ -277,7 +278,16 @@ def crlb(robot, theta_cmd, params="paper", noise: NoiseModel | None = None, err0
 
 
 def crlb_zero_offsets_deg(robot, theta_cmd, params="paper", noise=None, err0=None, prior_std=None):
-    """CRLB standard deviations of the zero offsets, degrees, shape (m,).
+    """CRLB standard deviations of the zero offsets, degrees, shape (m,): revolute joints
+    (:func:`crlb_zero_offsets_user` for any)."""
+    if robot.errors.offset_unit != "rad":
+        raise ValueError("crlb_zero_offsets_deg: this mechanism's zero offsets are lengths (mm); use "
+                         "crlb_zero_offsets_user")
+    return crlb_zero_offsets_user(robot, theta_cmd, params, noise, err0, prior_std)
+
+
+def crlb_zero_offsets_user(robot, theta_cmd, params="paper", noise=None, err0=None, prior_std=None):
+    """CRLB standard deviations of the zero offsets in file units (deg or mm), shape (m,).
 
     Raises
     ------
@@ -290,7 +300,7 @@ def crlb_zero_offsets_deg(robot, theta_cmd, params="paper", noise=None, err0=Non
         raise ValueError(f"the parameter set does not contain the zero offsets {', '.join(missing)}")
     cov = crlb(robot, theta_cmd, params, noise, err0, prior_std)
     pos = [names.index(n) for n in robot.errors.zero_offsets]
-    return np.degrees(np.sqrt(np.diag(cov)[pos]))
+    return units.to_user(np.sqrt(np.diag(cov)[pos]), robot.errors.offset_unit)
 
 
 def model_bias(robot, theta_cmd, err_true, params="paper", noise: NoiseModel | None = None, err0=None):
@@ -316,7 +326,7 @@ def model_bias(robot, theta_cmd, err_true, params="paper", noise: NoiseModel | N
     ndarray, shape (p,)
         Bias of each parameter (rad, mm).
     """
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     idx = robot.errors.indices(params)
     omit = [i for i in range(len(robot.errors)) if i not in idx]
     err0 = robot.errors.zeros() if err0 is None else robot.errors.check_vector(err0)

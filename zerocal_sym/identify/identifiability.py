@@ -64,7 +64,7 @@ def scaled_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | Non
     ``noise=NoiseModel()`` (zero) means unweighted (mm per scaled mm);
     default: the paper's noise model.
     """
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     A = fisher.sensitivity(robot, theta_cmd, params, err0) / fisher.parameter_scale(robot, params)
     if noise.is_zero:
         return A
@@ -162,7 +162,7 @@ def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel |
     """
     errors = robot.errors
     names = errors.resolve(params)
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
     As = scaled_sensitivity(robot, theta_cmd, names, noise, err0)
     scale = fisher.parameter_scale(robot, names)

@@ -151,7 +151,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
     robot, methods, names, noise = task.robot, task.methods, task.names, task.noise
     errors = robot.errors
     offs = errors.zero_offsets
-    paper4 = errors.resolve("offsets+measuring")
+    paper4 = errors.resolve("default")
     m_, n_ = len(offs), len(errors.measuring)
     report = task.report or _identity_report
     plant = VirtualPlant(robot, task.err)
@@ -293,7 +293,7 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
     errors = robot.errors
     offs = errors.zero_offsets
     workers = check_execution(workers, scheduler)
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     methods = tuple(methods)
     unknown = [m for m in methods if m not in METHODS]
     if unknown:

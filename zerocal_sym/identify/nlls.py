@@ -156,7 +156,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         residuals"`` (zero noise model).
     """
     t0 = time.perf_counter()
-    noise = NoiseModel.coerce(noise)
+    noise = NoiseModel.coerce(noise, robot=robot)
     if loss not in LOSSES:
         raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     delta = None
@@ -340,7 +340,7 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     scale : ndarray, shape (p,)
         ``p = z / scale`` (physical units); start at ``prior[params] * scale``.
     """
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     errors = robot.errors
     names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))

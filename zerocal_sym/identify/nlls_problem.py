@@ -65,6 +65,10 @@ IPOPT_OPTIONS = {
 #: up to this K the functions are SX, expanded (fastest to evaluate); above, MX graphs with the per-pose
 #: model mapped over K (build time and memory linear in K, no K-fold inlining)
 EXPAND_MAX_K = 120
+#: a per-pose model larger than this (CasADi nodes of the distance and its joint derivative) is never
+#: expanded: K inlined copies of a forward kinematics solved by Newton steps (the hexapod's, ~50 000 nodes)
+#: and their symbolic Jacobian would take minutes and gigabytes to build
+EXPAND_MAX_NODES = 20000
 
 _CACHE: dict = {}
 _LOCK = threading.Lock()
@@ -184,7 +188,7 @@ class NllsProblem:
         rho1 = f(th1, g1, e1)
         pose = ca.Function("pose", [th1, g1, e1], [rho1, ca.sumsqr(ca.jacobian(rho1, th1))])
         pose_k = pose.map(K)
-        X = ca.SX if K <= EXPAND_MAX_K else ca.MX
+        X = ca.SX if K <= EXPAND_MAX_K and pose.n_nodes() <= EXPAND_MAX_NODES else ca.MX
         self.expanded = X is ca.SX
 
         z = X.sym("z", p)

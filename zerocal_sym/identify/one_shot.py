@@ -97,7 +97,7 @@ def one_shot_monte_carlo(robot, theta, err, trials: int, noise=None, params="pap
     """
     from zerocal_sym.model.noise import NoiseModel
 
-    noise = NoiseModel.paper() if noise is None else noise
+    noise = NoiseModel.coerce(noise, robot=robot)
     names = robot.errors.resolve(params)
     theta = np.atleast_2d(np.asarray(theta, float))
     err = robot.errors.check_vector(np.asarray(err, float), "err_true")

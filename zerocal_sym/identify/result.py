@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from zerocal_sym.model import units
+
 
 @dataclass
 class IdentificationResult:
@@ -80,21 +82,49 @@ class IdentificationResult:
         return self.errors.zero_offsets
 
     @property
-    def zero_offsets_rad(self) -> np.ndarray:
-        """Zero offsets in joint order (rad), shape (m,)."""
+    def zero_offsets(self) -> np.ndarray:
+        """Zero offsets in joint order (internal units: rad, mm), shape (m,)."""
         return np.array([self.value(n) for n in self.errors.zero_offsets])
 
     @property
+    def zero_offsets_user(self) -> np.ndarray:
+        """Zero offsets in joint order in file units (:attr:`offset_unit`: deg or mm), shape (m,)."""
+        return units.to_user(self.zero_offsets, self.errors.offset_unit)
+
+    @property
+    def std_zero_offsets_user(self) -> np.ndarray:
+        return units.to_user(np.array([self.std(n) for n in self.errors.zero_offsets]), self.errors.offset_unit)
+
+    @property
+    def offset_unit(self) -> str:
+        """File unit of the zero offsets: ``deg`` (revolute joints) or ``mm`` (prismatic)."""
+        return self.errors.offset_user_unit
+
+    def _revolute(self, what):
+        if self.errors.offset_unit != "rad":
+            raise AttributeError(f"{what}: the zero offsets of this mechanism are lengths (mm); use "
+                                 f"{what.replace('_deg', '_user').replace('_rad', '')}")
+
+    @property
+    def zero_offsets_rad(self) -> np.ndarray:
+        """Zero offsets in joint order (rad), shape (m,): revolute joints."""
+        self._revolute("zero_offsets_rad")
+        return self.zero_offsets
+
+    @property
     def zero_offsets_deg(self) -> np.ndarray:
-        return np.degrees(self.zero_offsets_rad)
+        """Zero offsets in joint order (deg), shape (m,): revolute joints."""
+        self._revolute("zero_offsets_deg")
+        return self.zero_offsets_user
 
     @property
     def std_zero_offsets_deg(self) -> np.ndarray:
-        return np.degrees([self.std(n) for n in self.errors.zero_offsets])
+        self._revolute("std_zero_offsets_deg")
+        return self.std_zero_offsets_user
 
     @property
     def maemm_mm(self) -> np.ndarray:
-        """MAEMM in pose-coordinate order (mm), shape (n,)."""
+        """The measuring errors (MAEMM) in their order (mm), shape (u,)."""
         return np.array([self.value(n) for n in self.errors.measuring])
 
     def user_value(self, name: str, v: float) -> float:
@@ -107,8 +137,9 @@ class IdentificationResult:
             "method": self.method,
             "status": self.status,
             "success": bool(self.success),
-            "zero_offsets_deg": self.zero_offsets_deg.tolist(),
-            "std_zero_offsets_deg": [None if not np.isfinite(s) else s for s in self.std_zero_offsets_deg.tolist()],
+            units.key("zero_offsets", self.errors.offset_unit): self.zero_offsets_user.tolist(),
+            units.key("std_zero_offsets", self.errors.offset_unit):
+                [None if not np.isfinite(s) else s for s in self.std_zero_offsets_user.tolist()],
             "maemm_mm": self.maemm_mm.tolist(),
             "params": list(self.params),
             "estimate": {n: self.user_value(n, v) for n, v in zip(self.params, self.estimate)},

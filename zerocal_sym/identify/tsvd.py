@@ -144,7 +144,7 @@ def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None
     from zerocal_sym.identify.linear import identification_matrix
 
     errors = robot.errors
-    names = errors.resolve("offsets+measuring")
+    names = errors.resolve("default")
     offs, maemm = errors.zero_offsets, errors.measuring
     p = len(names)
     th, readings = _validate(meas, robot, p)
@@ -299,7 +299,7 @@ def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rt
         for i in range(len(rounds)):
             alone(i)
         return out
-    names = errors.resolve("offsets+measuring")
+    names = errors.resolve("default")
     p = len(names)
     i_off = [errors.index(n) for n in errors.zero_offsets]
     i_meas = [errors.index(n) for n in errors.measuring]

@@ -19,6 +19,20 @@ def fmt_pose(p, spec: str = "g") -> str:
     return "(" + ", ".join(format(float(v), spec) for v in p) + ")"
 
 
+def fmt_user_pose(robot, p, spec: str = "g") -> str:
+    """A pose for messages in file units with its unit: ``(x, y, z) mm`` or ``(x, y, z mm, roll, pitch, yaw deg)``."""
+    from zerocal_sym.model import units
+
+    mech = robot.mechanism
+    u = [units.pose_unit(mech, name) for name in mech.pose_names]
+    v = units.pose_to_user(mech, np.asarray(p, float))
+    if len(set(u)) == 1:
+        return f"{fmt_pose(v, spec)} {u[0]}"
+    parts = [format(float(x), spec) + (f" {ui}" if k + 1 == len(u) or u[k + 1] != ui else "")
+             for k, (x, ui) in enumerate(zip(v, u))]
+    return "(" + ", ".join(parts) + ")"
+
+
 def _cols(a, n):
     a = np.asarray(a, dtype=float)
     if a.ndim == 1:
@@ -28,7 +42,7 @@ def _cols(a, n):
     return a
 
 
-def _call(robot, fname, *args):
+def call(robot, fname, *args):
     """Evaluate a generated function column-wise over K poses.
 
     Array arguments of shape (K, n) are passed as (n, K) to the function
@@ -46,6 +60,20 @@ def _call(robot, fname, *args):
         r, c = f.size_out(k)
         res.append(np.reshape(o, (r, c * K), order="F").reshape(r, K, c).transpose(1, 0, 2).copy())
     return res
+
+
+_call = call
+
+
+def ik_ratio(robot, P):
+    """Inverse kinematics and the reach ratios (``|ratio| <= 1`` where a limb closes within its travel).
+
+    Returns
+    -------
+    theta, ratio : ndarray, shape (K, m) each
+    """
+    theta, ratio = _call(robot, "ik", _cols(P, robot.n), robot.geometry)
+    return theta[:, :, 0], ratio[:, :, 0]
 
 
 def ik(robot, P, check: bool = True):
@@ -71,8 +99,8 @@ def ik(robot, P, check: bool = True):
         bad = np.flatnonzero(~np.all(np.abs(ratio[:, :, 0]) <= 1.0, axis=1) | ~np.all(np.isfinite(theta), axis=1))
         if bad.size:
             k = int(bad[0])
-            raise PoseError(f"pose {fmt_pose(P[k])} mm is unreachable (a limb cannot close)",
-                            where=f"pose {k}")
+            raise PoseError(f"pose {fmt_user_pose(robot, P[k])} is unreachable (a limb cannot close, or a joint "
+                            "is beyond its travel)", where=f"pose {k}")
     return theta
 
 
@@ -206,7 +234,7 @@ def check_poses(robot, P, margin=None, in_workspace=False, tol=1e-6):
         out = np.flatnonzero(~robot.workspace.contains(P, tol))
         if out.size:
             k = int(out[0])
-            raise PoseError(f"pose {fmt_pose(P[k])} mm is outside the workspace {robot.workspace.describe()}",
+            raise PoseError(f"pose {fmt_user_pose(robot, P[k])} is outside the workspace {robot.workspace.describe()}",
                             where=f"pose {k}")
     theta = ik(robot, P)
     margin = robot.singularity_margin if margin is None else margin
@@ -215,7 +243,7 @@ def check_poses(robot, P, margin=None, in_workspace=False, tol=1e-6):
     if bad.size:
         k = int(bad[0])
         raise PoseError(
-            f"pose {fmt_pose(P[k])} mm is too close to a singular configuration "
+            f"pose {fmt_user_pose(robot, P[k])} is too close to a singular configuration "
             f"(min |sin transmission angle| = {np.min(s[k]):.3g} < margin {margin:g})", where=f"pose {k}")
     return theta
 

@@ -153,16 +153,18 @@ class Mechanism:
         self.geometry_units = dict(mod.GEOMETRY_UNITS)
         names = [row[0] for row in mod.SOURCE_ERRORS]
         # "gauge_fixed": every source error but those that fix the gauge (identifiable from enough poses)
+        default_set = tuple(getattr(mod, "DEFAULT_SET", ())) or tuple(
+            row[0] for row in mod.SOURCE_ERRORS if row[1] in ("zero_offset", "measuring"))
         self.errors = SourceErrors(mod.SOURCE_ERRORS, {
-            **mod.PARAM_SETS, "gauge_fixed": tuple(n for n in names if n not in mod.GAUGE_FIX)})
+            **mod.PARAM_SETS, "gauge_fixed": tuple(n for n in names if n not in mod.GAUGE_FIX),
+            "default": default_set})
         self.source_error_names = list(self.errors.names)
         self.joint_kinds = list(getattr(mod, "JOINT_KINDS", ["revolute"] * len(self.joint_names)))
         self.pose_units = dict(getattr(mod, "POSE_UNITS", {p: "mm" for p in self.pose_names}))
         home = getattr(mod, "HOME_JOINTS", None)
         self.home_joints = None if home is None else np.array(home, float)
         self.home_pose_rule = getattr(mod, "HOME_POSE", None)
-        self.default_set = tuple(getattr(mod, "DEFAULT_SET", ())) or tuple(
-            n for n in names if self.errors[n].role in ("zero_offset", "measuring"))
+        self.default_set = default_set
         self.workspace_defaults = dict(getattr(mod, "WORKSPACE_DEFAULTS", {}))
         self.noise_defaults = dict(getattr(mod, "NOISE", {}))
         self.measuring_base = list(mod.MEASURING_BASE)
@@ -171,6 +173,7 @@ class Mechanism:
         self.gauge_fix = list(mod.GAUGE_FIX)
         self.workspace = mod.WORKSPACE
         self.aliases = dict(mod.ALIASES)
+        self.list_aliases = dict(getattr(mod, "LIST_ALIASES", {}))
         self.defaults = dict(mod.DEFAULTS)
         self.positive = list(mod.POSITIVE)
         self.n, self.m = len(self.pose_names), len(self.joint_names)

@@ -9,8 +9,14 @@ Noise (paper Section 6.1, each switchable and scalable):
 
 * scale error per measured change ``m_k ~ N(0, sigma_m^2)``,
   ``sigma_m = (3 + l0/1000)/3 um`` with ``l0 = 350 mm`` (Eq. 34);
-* servo motion error per joint per pose ``xi ~ N(0, sigma_xi^2)``,
+* joint positioning error per joint per pose ``xi ~ N(0, sigma_xi^2)``, in the
+  joints' unit; the paper's servo error (revolute joints)
   ``sigma_xi = (1/3)(4/10^4)(1/eta) 360 deg`` with ``eta = 20`` (Eq. 35).
+
+A robot's noise (:meth:`NoiseModel.of_robot`, the ``default`` of
+:data:`NOISE_NAMES`) is its robot file's ``[noise]`` (``scale`` mm, ``joint``
+in the joints' unit), else its mechanism's default (the linear Delta's
+0.002 mm and 0.005 mm), else the paper's.
 """
 from __future__ import annotations
 
@@ -20,8 +26,11 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 
-#: the names of :meth:`NoiseModel.named` (the CLI's ``--noise`` choices)
-NOISE_NAMES = ("paper", "scale-only", "servo-only", "none")
+#: the names of :meth:`NoiseModel.named` (the CLI's ``--noise`` choices): ``paper`` is the robot's default noise
+#: (the paper's Eqs. 34 and 35 unless the robot file or its mechanism gives its own), ``servo-only`` its joint term
+NOISE_NAMES = ("paper", "scale-only", "servo-only", "none", "default", "joint-only")
+#: names that stand for another
+NOISE_ALIASES = {"default": "paper", "joint-only": "servo-only"}
 
 
 def paper_sigma_scale_mm(l0_mm: float = 350.0) -> float:
@@ -42,15 +51,21 @@ class NoiseModel:
     ----------
     sigma_scale_mm : float
         Std of each measured change of the scale, mm.
-    sigma_servo_rad : float
-        Std of each joint's motion error at each pose, rad.
+    sigma_joint : float
+        Std of each joint's positioning error at each pose, in the joints' internal unit (rad for revolute
+        joints: the paper's servo error; mm for prismatic ones).
     """
 
     sigma_scale_mm: float = 0.0
-    sigma_servo_rad: float = 0.0
+    sigma_joint: float = 0.0
+
+    @property
+    def sigma_servo_rad(self) -> float:
+        """The joint term's former name (revolute joints: rad)."""
+        return self.sigma_joint
 
     def __post_init__(self):
-        for name in ("sigma_scale_mm", "sigma_servo_rad"):
+        for name in ("sigma_scale_mm", "sigma_joint"):
             v = getattr(self, name)
             try:
                 ok = bool(np.isfinite(v) and v >= 0)
@@ -65,19 +80,46 @@ class NoiseModel:
         return cls(scale * paper_sigma_scale_mm(), servo * paper_sigma_servo_rad())
 
     @classmethod
-    def named(cls, name: str) -> "NoiseModel":
-        """``paper`` | ``scale-only`` | ``servo-only`` | ``none`` (:data:`NOISE_NAMES`)."""
-        table = {"paper": cls.paper(), "scale-only": cls.paper(servo=0.0),
-                 "servo-only": cls.paper(scale=0.0), "none": cls()}
-        if name not in table:
-            raise ValueError(f"unknown noise model {name!r} (known: {', '.join(table)})")
+    def of_robot(cls, robot) -> "NoiseModel":
+        """The robot's noise: its file's ``[noise]``, else its mechanism's default, else the paper's."""
+        from zerocal_sym.model import units
+
+        mech = robot.mechanism
+        given = {**mech.noise_defaults, **dict(getattr(robot, "noise_values", ()))}
+        base = cls.paper()
+        scale = float(given.get("scale", base.sigma_scale_mm))
+        if "joint" in given:
+            joint = float(units.joints_from_user(mech, given["joint"]))
+        elif mech.joint_kind == "revolute":
+            joint = base.sigma_joint
+        else:
+            raise ValueError(f"mechanism {mech.name!r} (prismatic joints) has no default joint noise: give "
+                             "[noise] joint = ... (mm) in the robot file")
+        return cls(scale, joint)
+
+    def scaled(self, scale: float = 1.0, joint: float = 1.0) -> "NoiseModel":
+        """Each term multiplied by a factor."""
+        return NoiseModel(self.sigma_scale_mm * scale, self.sigma_joint * joint)
+
+    @classmethod
+    def named(cls, name: str, robot=None) -> "NoiseModel":
+        """``paper`` (the robot's default) | ``scale-only`` | ``servo-only`` | ``none`` (:data:`NOISE_NAMES`).
+
+        With ``robot`` the terms are the robot's (:meth:`of_robot`); without, the paper's.
+        """
+        name = NOISE_ALIASES.get(name, name)
+        if name not in NOISE_NAMES:
+            raise ValueError(f"unknown noise model {name!r} (known: {', '.join(NOISE_NAMES)})")
+        base = cls.paper() if robot is None else cls.of_robot(robot)
+        table = {"paper": base, "scale-only": base.scaled(joint=0.0),
+                 "servo-only": base.scaled(scale=0.0), "none": cls()}
         return table[name]
 
     @classmethod
-    def coerce(cls, noise, what: str = "noise") -> "NoiseModel":
+    def coerce(cls, noise, what: str = "noise", robot=None) -> "NoiseModel":
         """The noise model an identification argument names.
 
-        ``None``: the paper's (:meth:`paper`); a :class:`NoiseModel`: itself;
+        ``None``: the robot's (:meth:`of_robot`; the paper's without a robot); a :class:`NoiseModel`: itself;
         a name (``str``): :meth:`named`, the names the CLI's ``--noise`` and
         a study spec's ``noise`` list accept.
 
@@ -90,12 +132,12 @@ class NoiseModel:
             ``NoiseModel.paper(f, f)``).
         """
         if noise is None:
-            return cls.paper()
+            return cls.paper() if robot is None else cls.of_robot(robot)
         if isinstance(noise, NoiseModel):
             return noise
         if isinstance(noise, str):
             try:
-                return cls.named(noise)
+                return cls.named(noise, robot)
             except ValueError as exc:
                 raise ValueError(f"{what}: {exc}") from None
         raise TypeError(f"{what} must be a NoiseModel, one of the names {', '.join(NOISE_NAMES)} or None (the "
@@ -104,7 +146,20 @@ class NoiseModel:
 
     @property
     def is_zero(self) -> bool:
-        return self.sigma_scale_mm == 0 and self.sigma_servo_rad == 0
+        return self.sigma_scale_mm == 0 and self.sigma_joint == 0
+
+    def to_dict(self, robot=None) -> dict:
+        """``{"sigma_scale_mm": ..., "sigma_servo_rad": ...}`` (revolute joints) or ``{..., "sigma_joint_mm": ...}``
+        (prismatic), the joint term in the robot's internal unit."""
+        if robot is not None and robot.mechanism.joint_kind == "prismatic":
+            return {"sigma_scale_mm": float(self.sigma_scale_mm), "sigma_joint_mm": float(self.sigma_joint)}
+        return {"sigma_scale_mm": float(self.sigma_scale_mm), "sigma_servo_rad": float(self.sigma_joint)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "NoiseModel":
+        """The inverse of :meth:`to_dict`."""
+        joint = d.get("sigma_servo_rad", d.get("sigma_joint_mm", d.get("sigma_joint", 0.0)))
+        return cls(d["sigma_scale_mm"], joint)
 
 
 class VirtualPlant:
@@ -142,9 +197,9 @@ class VirtualPlant:
         ndarray, shape (K,)
         """
         theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
-        if noise is not None and noise.sigma_servo_rad > 0:
+        if noise is not None and noise.sigma_joint > 0:
             rng = np.random.default_rng(rng)
-            theta_cmd = theta_cmd + rng.normal(0.0, noise.sigma_servo_rad, theta_cmd.shape)
+            theta_cmd = theta_cmd + rng.normal(0.0, noise.sigma_joint, theta_cmd.shape)
         return kin.distance(self.robot, theta_cmd, self.err)
 
     def measure(self, theta_cmd, noise: NoiseModel | None = None, rng=None):
@@ -173,8 +228,8 @@ class VirtualPlant:
 def geometry_error(robot, err) -> np.ndarray:
     """The geometry and measuring part of the source errors on the geometry vector, shape (G,).
 
-    A measuring-mechanism error is carried on the base point ``c`` (it enters
-    the distance only through ``c + d``).
+    A measuring-mechanism error is carried on its target, an entry of the base
+    point ``c`` or of the platform point ``d``.
     """
     names = robot.mechanism.geometry_names
     dg = np.zeros(len(names))

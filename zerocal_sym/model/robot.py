@@ -5,8 +5,10 @@ geometry and the workspace, in tables or (the paper's flat files) at the top::
 
     name = "my delta"
     mechanism = "delta_rotary"        # default "planar_2dof"
+    mechanism_module = "my_mech.py"   # optional: a mechanism of your own (a generated module beside this file,
+                                      # or a dotted module name)
     singularity_margin = 0.2          # optional
-    home = [0, 0, 0]                  # optional, deg (default: the mechanism's)
+    home = [0, 0, 0]                  # optional, the joints' unit (deg, mm) (default: the mechanism's)
 
     [geometry]                        # the mechanism's geometry names, or aliases
     R = 200                           # alias: R1 = R2 = R3 = 200
@@ -21,11 +23,16 @@ geometry and the workspace, in tables or (the paper's flat files) at the top::
     H = 700
     h = 200
 
+    [noise]                           # optional: the measurement noise (default: the mechanism's, else the paper's)
+    scale = 0.002                     # mm per measured change of the scale
+    joint = 0.005                     # per joint per pose, in the joints' unit (deg for revolute, mm for prismatic)
+
 An alias (``L`` for ``L1 = L2``, the planar ``ex`` for ``e1x = ex, e2x = -ex``)
 sets several entries; an entry named explicitly wins over its alias (``L = 375``
 with ``L2 = 380``).  Entries the mechanism gives defaults for may be left out
 (the Delta's azimuths 0/120/240 deg).  Angles (the Delta's ``phi_i``) are
-given in degrees.
+given in degrees.  A list key gives one value per entry (the hexapod's
+``base_angles = [345, 15, 105, 135, 225, 255]``).
 
 The paper's flat files (``ex = 80``, ``L = 375``, ``H = 632``, ...) keep
 working with the same :attr:`Robot.sha256`.  The paper's robot (Table 1) is
@@ -43,7 +50,8 @@ from pathlib import Path
 import numpy as np
 
 from zerocal_sym.errors import RobotFileError
-from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, REGISTRY, get_mechanism
+from zerocal_sym.model import units
+from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, get_mechanism, known_mechanisms, register_mechanism
 from zerocal_sym.model.workspace import SHAPES
 
 #: Paper Table 1 (with the OCR-dropped ``ey = 0`` restored), mm.
@@ -51,10 +59,12 @@ PAPER_TABLE1 = dict(ex=80.0, ey=0.0, L=375.0, l=825.0, H=632.0, b=480.0, h=150.0
                     cx=0.0, cy=79.0, dx=0.0, dy=51.0)
 
 DEFAULT_SINGULARITY_MARGIN = 0.2
-#: home joint angles beyond this are a unit or typing error (deg; the data files' limit)
-HOME_LIMIT_DEG = 3600.0
-TOP_KEYS = ("name", "mechanism", "units", "singularity_margin", "home")
-TABLES = ("geometry", "workspace")
+#: home joint values beyond this are a unit or typing error (file units; the data files' limits)
+HOME_LIMIT = {"deg": 3600.0, "mm": 1e5}
+HOME_LIMIT_DEG = HOME_LIMIT["deg"]
+TOP_KEYS = ("name", "mechanism", "mechanism_module", "units", "singularity_margin", "home")
+TABLES = ("geometry", "workspace", "noise")
+NOISE_KEYS = ("scale", "joint")
 
 
 @dataclass(frozen=True)
@@ -67,7 +77,9 @@ class Robot:
         In the mechanism's ``geometry_names`` order (mm; rad for angles).
     workspace : Rectangle or Cylinder
     home : ndarray, shape (m,) or None
-        Home joints (rad) if the file overrides the mechanism's.
+        Home joints (internal units: rad, mm) if the file overrides the mechanism's.
+    noise_values : tuple of (str, float)
+        The robot file's ``[noise]`` (``scale`` mm, ``joint`` in the joints' file unit).
     """
 
     geometry: np.ndarray
@@ -78,6 +90,7 @@ class Robot:
     singularity_margin: float = DEFAULT_SINGULARITY_MARGIN
     home: np.ndarray | None = None
     keys: dict = field(default_factory=dict, compare=False)
+    noise_values: tuple = ()
 
     @property
     def mechanism(self):
@@ -108,10 +121,12 @@ class Robot:
         return self.errors.scale(names, self.param)
 
     @property
-    def measuring_point(self) -> np.ndarray:
-        """``c + d`` (mm), shape (n,)."""
-        mech = self.mechanism
-        return self.params(mech.measuring_base) + self.params(mech.measuring_offset)
+    def noise(self):
+        """The robot's measurement noise (:class:`~zerocal_sym.model.noise.NoiseModel`): the robot file's
+        ``[noise]``, else the mechanism's default, else the paper's (Eqs. 34, 35)."""
+        from zerocal_sym.model.noise import NoiseModel
+
+        return NoiseModel.of_robot(self)
 
     def workspace_bounds(self):
         """Bounding box of the workspace, ``(lo, hi)`` ndarray shape (n,) each."""
@@ -124,24 +139,41 @@ class Robot:
         return self.workspace.grid(*args)
 
     def home_joints(self) -> np.ndarray:
-        """Home joints (rad), shape (m,)."""
-        return self.mechanism.home_joints.copy() if self.home is None else np.array(self.home, float)
+        """Home joints (internal units: rad, mm), shape (m,): the file's, the mechanism's, or the IK of its
+        home pose."""
+        if self.home is not None:
+            return np.array(self.home, float)
+        mech = self.mechanism
+        if mech.home_joints is not None:
+            return mech.home_joints.copy()
+        from zerocal_sym.model.kinematics import ik
+
+        return ik(self, self.nominal_home_pose()[None, :], check=False)[0]
+
+    def nominal_home_pose(self) -> np.ndarray:
+        """The mechanism's home pose (a home-pose mechanism only), shape (n,)."""
+        rule = self.mechanism.home_pose_rule
+        if rule == "workspace centre":
+            return self.workspace.centre()
+        return np.array(self.mechanism[rule](self.geometry).full(), float).ravel()
 
     def home_pose(self) -> np.ndarray:
-        """Home position P0, mm, shape (n,)."""
+        """Home pose P0 (mm, rad), shape (n,): the forward kinematics of the home joints."""
         from zerocal_sym.model.kinematics import fk
 
         return fk(self, self.home_joints()[None, :])[0]
 
     def to_dict(self) -> dict:
         """Geometry (file units: mm, deg), workspace, mechanism and margin: what :attr:`sha256` hashes."""
-        units = self.mechanism.geometry_units
-        d = {k: float(np.degrees(v)) if units.get(k) == "rad" else float(v)
+        geo_units = self.mechanism.geometry_units
+        d = {k: float(units.to_user(v, geo_units.get(k, "mm")))
              for k, v in zip(self.mechanism.geometry_names, self.geometry)}
         d.update(self.workspace.to_dict())
         d.update(mechanism=self.mechanism_name, singularity_margin=self.singularity_margin)
         if self.home is not None:
-            d["home_deg"] = np.degrees(self.home).tolist()
+            d[units.joint_key(self, "home")] = units.joints_to_user(self, self.home).tolist()
+        if self.noise_values:
+            d["noise"] = dict(self.noise_values)
         return d
 
     @property
@@ -153,9 +185,12 @@ class Robot:
 def _geometry(mech, values: dict, where) -> np.ndarray:
     """Geometry vector from explicit entries, aliases and defaults (file units)."""
     out, missing = [], []
+    listed = {part: (alias, k) for alias, parts in mech.list_aliases.items() for k, part in enumerate(parts)}
     for name in mech.geometry_names:
         if name in values:
             v = values[name]
+        elif name in listed and listed[name][0] in values:
+            v = values[listed[name][0]][listed[name][1]]
         else:
             v = None
             for alias, parts in mech.aliases.items():
@@ -167,7 +202,7 @@ def _geometry(mech, values: dict, where) -> np.ndarray:
             alias = [a for a, parts in mech.aliases.items() if name in parts]
             missing.append(f"{alias[0]} (or {' and '.join(mech.aliases[alias[0]])})" if alias else name)
             continue
-        out.append(np.radians(v) if mech.geometry_units.get(name) == "rad" else float(v))
+        out.append(float(units.from_user(float(v), mech.geometry_units.get(name, "mm"))))
     if missing:
         raise RobotFileError(f"missing key(s): {', '.join(dict.fromkeys(missing))}", where=where(None))
     return np.array(out, float)
@@ -177,20 +212,23 @@ def _from_keys(keys: dict, name: str, source: str, where=None) -> Robot:
     """A :class:`Robot` from checked keys (flat or in ``geometry``/``workspace`` tables)."""
     where = where or (lambda key: source)
     mech = get_mechanism(str(keys.get("mechanism", DEFAULT_MECHANISM)))
-    flat = {k: v for k, v in keys.items() if k not in TOP_KEYS + TABLES}
-    geo = {**{k: v for k, v in flat.items() if k not in SHAPES[mech.workspace].keys}, **keys.get("geometry", {})}
-    ws_values = {**{k: v for k, v in flat.items() if k in SHAPES[mech.workspace].keys}, **keys.get("workspace", {})}
-    ws_values.pop("shape", None)
     ws_cls = SHAPES[mech.workspace]
+    flat = {k: v for k, v in keys.items() if k not in TOP_KEYS + TABLES}
+    geo = {**{k: v for k, v in flat.items() if k not in ws_cls.keys}, **keys.get("geometry", {})}
+    ws_values = {**mech.workspace_defaults, **{k: v for k, v in flat.items() if k in ws_cls.keys},
+                 **keys.get("workspace", {})}
+    ws_values.pop("shape", None)
     geometry = _geometry(mech, geo, where)
-    missing = [k for k in ws_cls.keys if k not in ws_values]
-    if missing:
-        raise RobotFileError(f"missing key(s): {', '.join(missing)}", where=where(None))
+    try:
+        workspace = ws_cls.from_values(ws_values)
+    except KeyError as exc:
+        raise RobotFileError(f"missing or conflicting workspace key(s): {exc.args[0]}", where=where(None)) from None
     home = keys.get("home")
-    return Robot(geometry=geometry, workspace=ws_cls(**{k: float(ws_values[k]) for k in ws_cls.keys}),
+    return Robot(geometry=geometry, workspace=workspace,
                  name=name, mechanism_name=mech.name, source=source,
                  singularity_margin=float(keys.get("singularity_margin", DEFAULT_SINGULARITY_MARGIN)),
-                 home=None if home is None else np.radians(np.asarray(home, float)), keys=dict(keys))
+                 home=None if home is None else units.joints_from_user(mech, home), keys=dict(keys),
+                 noise_values=tuple((k, float(v)) for k, v in keys.get("noise", {}).items()))
 
 
 def paper_robot() -> Robot:
@@ -230,25 +268,44 @@ def _check_number(k, v, unit, where):
 
 def _check_keys(keys: dict, where) -> None:
     """Types, names and units of every key, before anything is computed."""
-    for k in ("name", "mechanism", "units"):
+    for k in ("name", "mechanism", "mechanism_module", "units"):
         if k in keys and not isinstance(keys[k], str):
             raise RobotFileError(f"key '{k}' must be a string", where=where(k))
     mech_name = keys.get("mechanism", DEFAULT_MECHANISM)
-    if mech_name not in REGISTRY:
-        raise RobotFileError(f"unknown mechanism {mech_name!r} (known: {', '.join(REGISTRY)})",
-                             where=where("mechanism"))
+    if mech_name not in known_mechanisms():
+        raise RobotFileError(f"unknown mechanism {mech_name!r} (known: {', '.join(known_mechanisms())}; a mechanism "
+                             "of your own: mechanism_module = \"its_generated_module.py\")", where=where("mechanism"))
     if keys.get("units", "mm") != "mm":
         raise RobotFileError(f"units = {keys['units']!r} is not supported: robot files are in mm",
                              where=where("units"))
     mech = get_mechanism(mech_name)
     ws_cls = SHAPES[mech.workspace]
-    geo_keys = tuple(mech.geometry_names) + tuple(mech.aliases)
+    geo_keys = tuple(mech.geometry_names) + tuple(mech.aliases) + tuple(mech.list_aliases)
+    ju = mech.joint_user_unit
 
     def unit(k):
+        if k in getattr(ws_cls, "angles", ()) or k == "ring_azimuth":
+            return "deg"
         return "deg" if mech.geometry_units.get(k) == "rad" else "mm"
+
+    def check_list(k, v):
+        n = len(mech.list_aliases[k])
+        if not isinstance(v, list) or len(v) != n or not all(_is_finite_number(x) for x in v):
+            raise RobotFileError(f"key '{k}' must be a list of {n} finite numbers ({unit(mech.list_aliases[k][0])}), "
+                                 f"got {_shown(v) if not isinstance(v, list) else 'a list of ' + str(len(v))}",
+                                 where=where(k))
 
     allowed = TOP_KEYS + geo_keys + ws_cls.keys
     for k, v in keys.items():
+        if k == "noise" and isinstance(v, dict):
+            for kk, vv in v.items():
+                if kk not in NOISE_KEYS:
+                    raise RobotFileError(f"unknown key '{kk}' in [noise] (allowed: {', '.join(NOISE_KEYS)})",
+                                         where=where(kk))
+                _check_number(kk, vv, "mm" if kk == "scale" else ju, where)
+                if vv < 0:
+                    raise RobotFileError(f"[noise] {kk} is a standard deviation: >= 0, got {vv!r}", where=where(kk))
+            continue
         if k in TABLES and isinstance(v, dict):
             inner = geo_keys if k == "geometry" else ws_cls.keys + ("shape",)
             for kk, vv in v.items():
@@ -262,19 +319,28 @@ def _check_keys(keys: dict, where) -> None:
                     continue
                 if kk in keys and kk not in TABLES:
                     raise RobotFileError(f"key '{kk}' given twice (top level and [{k}])", where=where(kk))
+                if kk in mech.list_aliases:
+                    check_list(kk, vv)
+                    continue
                 _check_number(kk, vv, unit(kk), where)
             continue
+        if k in TABLES:
+            raise RobotFileError(f"'{k}' must be a table ([{k}])", where=where(k))
         if k not in allowed:
             raise RobotFileError(f"unknown key '{k}' (allowed: {', '.join(allowed + TABLES)})", where=where(k))
-        if k in ("name", "mechanism", "units"):
+        if k in ("name", "mechanism", "mechanism_module", "units"):
+            continue
+        if k in mech.list_aliases:
+            check_list(k, v)
             continue
         if k == "home":
+            lim = HOME_LIMIT[ju]
             if (not isinstance(v, list) or len(v) != mech.m
                     or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)):
-                raise RobotFileError(f"home must be a list of {mech.m} joint angles (deg), got {v!r}",
+                raise RobotFileError(f"home must be a list of {mech.m} joint values ({ju}), got {v!r}",
                                      where=where(k))
-            if not all(_is_finite_number(x) and abs(float(x)) <= HOME_LIMIT_DEG for x in v):
-                raise RobotFileError(f"home must be {mech.m} finite joint angles within +-{HOME_LIMIT_DEG:g} deg, "
+            if not all(_is_finite_number(x) and abs(float(x)) <= lim for x in v):
+                raise RobotFileError(f"home must be {mech.m} finite joint values within +-{lim:g} {ju}, "
                                      f"got [{', '.join(_shown(x) for x in v)}]", where=where(k))
             continue
         _check_number(k, v, "mm" if k in ws_cls.keys or k == "singularity_margin" else unit(k), where)
@@ -299,6 +365,27 @@ def read_toml(path, error, what: str) -> dict:
         raise error(f"not valid TOML: {exc}", where=f"{path}:{m.group(1)}" if m else str(path)) from None
 
 
+def _register_module(keys: dict, path: Path, where) -> None:
+    """Register the robot file's ``mechanism_module`` (a ``.py`` file relative to the file, or a module name)."""
+    module = keys.get("mechanism_module")
+    if module is None:
+        return
+    if not isinstance(module, str) or "mechanism" not in keys:
+        raise RobotFileError("mechanism_module goes with mechanism = \"<its name>\" (a string each)",
+                             where=where("mechanism_module"))
+    if module.endswith(".py"):
+        file = (path.parent / module).resolve()
+        if not file.is_file():
+            raise RobotFileError(f"mechanism_module {module!r}: no such file ({file})", where=where("mechanism_module"))
+        module = str(file)
+    try:
+        register_mechanism(str(keys["mechanism"]), module)
+        get_mechanism(str(keys["mechanism"]))
+    except Exception as exc:  # noqa: BLE001 -- a user's module: any failure to import or check it is theirs
+        raise RobotFileError(f"mechanism_module {keys['mechanism_module']!r} cannot be loaded as mechanism "
+                             f"{keys['mechanism']!r}: {type(exc).__name__}: {exc}", where=where("mechanism_module"))
+
+
 def load_robot(path) -> Robot:
     """Read and validate a robot TOML file.
 
@@ -315,6 +402,7 @@ def load_robot(path) -> Robot:
         line = _line_of(text, key) if key else None
         return f"{path}:{line}" if line else str(path)
 
+    _register_module(keys, path, where)
     _check_keys(keys, where)
     robot = _from_keys(keys, str(keys.get("name", path.stem)), str(path), where)
     validate(robot, where=where)
@@ -342,7 +430,7 @@ def validate(robot: Robot, where=None) -> dict:
     RobotFileError
     """
     from zerocal_sym.errors import PoseError
-    from zerocal_sym.model.kinematics import fk, ik, transmission
+    from zerocal_sym.model.kinematics import fk, ik, ik_ratio, transmission
 
     where = where or (lambda key: robot.source)
     mech = robot.mechanism
@@ -369,13 +457,19 @@ def validate(robot: Robot, where=None) -> dict:
     def fmt(p):
         return "(" + ", ".join(f"{v:g}" for v in p) + ")"
 
-    summary = {"home_pose_mm": None, "corners": {}}
-    for label, p in robot.workspace_corners().items():
-        try:
-            th = ik(robot, np.array([p]))
-        except PoseError:
-            raise RobotFileError(f"workspace corner {label} = {fmt(p)} mm is unreachable", where=robot.source) from None
-        summary["corners"][label] = {"pose_mm": list(p), "joints_deg": np.degrees(th[0]).tolist()}
+    jkey = units.joint_key(robot, "joints")
+    summary = {units.pose_key(robot, "home_pose"): None, "corners": {}}
+    corners = robot.workspace_corners()
+    P_c = np.array(list(corners.values()), float)
+    th_c = ik(robot, P_c, check=False)
+    _, ratio = ik_ratio(robot, P_c)
+    for (label, p), th, ok in zip(corners.items(), th_c, np.all(np.abs(ratio) <= 1, axis=1) & np.all(
+            np.isfinite(th_c), axis=1)):
+        if not ok:
+            raise RobotFileError(f"workspace corner {label} = {fmt(units.pose_to_user(robot, p))} is unreachable "
+                                 "(a limb cannot close, or a joint is beyond its travel)", where=robot.source)
+        summary["corners"][label] = {units.pose_key(robot, "pose"): units.pose_to_user(robot, p).tolist(),
+                                     jkey: units.joints_to_user(robot, th).tolist()}
     grid = robot.workspace_grid()
     try:
         th = ik(robot, grid)
@@ -385,8 +479,9 @@ def validate(robot: Robot, where=None) -> dict:
     dev = np.linalg.norm(back - grid, axis=1)
     bad = np.flatnonzero(~(dev < 1e-6))
     if bad.size:
-        raise RobotFileError(f"forward and inverse kinematics disagree at {fmt(grid[bad[0]])} mm: "
-                             "the workspace crosses an assembly-mode change", where=robot.source)
+        raise RobotFileError(f"forward and inverse kinematics disagree at {fmt(units.pose_to_user(robot, grid[bad[0]]))}: "
+                             "the workspace crosses an assembly-mode change (or the forward kinematics' solve "
+                             "does not converge there)", where=robot.source)
     s = np.abs(transmission(robot, grid, th))
     k = int(np.argmin(np.min(s, axis=1)))
     smin = float(np.min(s[k]))
@@ -398,19 +493,24 @@ def validate(robot: Robot, where=None) -> dict:
     home = robot.home_pose()
     if not np.all(np.isfinite(home)):
         raise RobotFileError("the home joints are not an assembly of the robot", where=where("home"))
+    jr = units.joints_to_user(robot, np.array([th.min(), th.max()]))
     summary.update(
         name=robot.name, source=robot.source, mechanism=robot.mechanism_name,
         description=mech.description,
-        home_pose_mm=home.tolist(),
-        home_joints_deg=np.degrees(robot.home_joints()).tolist(),
+        joint_kind=mech.joint_kind,
+        joint_unit=mech.joint_user_unit,
+        pose_names=list(mech.pose_names),
+        pose_units=[units.pose_unit(mech, p) for p in mech.pose_names],
+        **{units.pose_key(robot, "home_pose"): units.pose_to_user(robot, home).tolist()},
+        **{units.joint_key(robot, "home_joints"): units.joints_to_user(robot, robot.home_joints()).tolist()},
         geometry_mm=robot.to_dict(),
         workspace=robot.workspace.kind,
         workspace_mm=robot.workspace.ranges(),
-        joint_range_deg=[float(np.degrees(th.min())), float(np.degrees(th.max()))],
+        **{units.joint_key(robot, "joint_range"): [float(jr[0]), float(jr[1])]},
         fk_ik_max_error_mm=float(dev.max()),
         singularity_margin=robot.singularity_margin,
         min_transmission_sine=smin,
-        min_transmission_sine_at_mm=grid[k].tolist(),
+        **{units.pose_key(robot, "min_transmission_sine_at"): units.pose_to_user(robot, grid[k]).tolist()},
         sha256=robot.sha256,
     )
     return summary

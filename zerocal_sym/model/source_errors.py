@@ -16,8 +16,13 @@ Parameter sets (:meth:`SourceErrors.resolve`)
     the MAEMM components (pose-coordinate order);
 ``geometry`` (alias ``geometric``)
     every geometric error;
-``offsets+measuring`` (alias ``paper``)
-    the paper's identification parameters (Eq. 28);
+``offsets+measuring``
+    the zero offsets and every measuring error;
+``default`` (alias ``paper``)
+    the mechanism's default identified set: the paper's identification
+    parameters (Eq. 28, the offsets and the MAEMM) where the data identify
+    them; a mechanism declares a smaller one where they do not (the linear
+    Delta holds ``rMz``: a common carriage offset is a vertical shift);
 ``all``
     every source error;
 ``gauge_fixed``
@@ -25,8 +30,10 @@ Parameter sets (:meth:`SourceErrors.resolve`)
 plus the mechanism's own sets (``lengths``, ``base``) and single names,
 combined with ``+`` or ``,`` (``offsets+measuring+L1,L2``).
 
-Units: rad for angles, mm for lengths inside; :meth:`SourceErrors.to_user` /
-:meth:`SourceErrors.from_user` convert angles to and from degrees.
+Units: rad for angles, mm for lengths inside; :meth:`SourceErrors.to_user_value` /
+:meth:`SourceErrors.from_user` convert angles to and from degrees.  The zero
+offsets have their joints' unit (:attr:`SourceErrors.offset_unit`: rad for
+revolute joints, mm for prismatic ones).
 """
 from __future__ import annotations
 
@@ -41,9 +48,11 @@ GENERIC_SETS = {
     "maemm": ("measuring",),
     "geometry": ("geometry",),
     "geometric": ("geometry",),
-    "paper": ("zero_offset", "measuring"),
+    "offsets+measuring": ("zero_offset", "measuring"),
     "all": ROLES,
 }
+#: set names standing for another (``paper``: the mechanism's default set)
+SET_ALIASES = {"paper": "default"}
 
 
 @dataclass(frozen=True)
@@ -70,6 +79,11 @@ class SourceError:
         """``deg`` for angles, ``mm`` otherwise."""
         return "deg" if self.unit == "rad" else "mm"
 
+    @property
+    def length_unit(self) -> str:
+        """The unit of ``lever * value``, what the paper's linear model estimates: always mm."""
+        return "mm"
+
 
 class SourceErrors:
     """The ordered source errors of one mechanism.
@@ -91,6 +105,7 @@ class SourceErrors:
             if e.role not in ROLES:
                 raise ValueError(f"source error {e.name!r}: unknown role {e.role!r}")
         self.extra_sets = dict(extra_sets or {})
+        self.extra_sets.setdefault("default", tuple(e.name for e in self.items if e.role in ("zero_offset", "measuring")))
         self._resolved = {}   # resolve(spec) by spec: the sets and names do not change after construction
 
     def __len__(self) -> int:
@@ -120,8 +135,23 @@ class SourceErrors:
         return self.of_role("geometry")
 
     @property
+    def offset_unit(self) -> str:
+        """Internal unit of the zero offsets: ``rad`` (revolute joints) or ``mm`` (prismatic)."""
+        return self[self.zero_offsets[0]].unit
+
+    @property
+    def offset_user_unit(self) -> str:
+        """File unit of the zero offsets: ``deg`` or ``mm``."""
+        return self[self.zero_offsets[0]].user_unit
+
+    @property
+    def default(self) -> tuple:
+        """The mechanism's default identified set."""
+        return self.extra_sets["default"]
+
+    @property
     def set_names(self) -> tuple:
-        return tuple(GENERIC_SETS) + tuple(self.extra_sets)
+        return tuple(GENERIC_SETS) + tuple(SET_ALIASES) + tuple(self.extra_sets)
 
     # ------------------------------------------------------------- by name
     def index(self, name: str) -> int:
@@ -163,6 +193,7 @@ class SourceErrors:
             spec = [p.strip() for p in spec.replace("+", ",").split(",") if p.strip()]
         chosen = set()
         for p in spec:
+            p = SET_ALIASES.get(p, p)
             if p in GENERIC_SETS:
                 chosen.update(n for role in GENERIC_SETS[p] for n in self.of_role(role))
             elif p in self.extra_sets:
@@ -186,18 +217,27 @@ class SourceErrors:
             v[self.index(name)] = float(val)
         return v
 
-    def assemble(self, zero_offsets_deg=None, geometry=None, maemm_mm=None) -> np.ndarray:
-        """A vector from the zero offsets (deg, joint order), geometric errors by name and the MAEMM (mm).
+    def assemble(self, zero_offsets_deg=None, geometry=None, maemm_mm=None, zero_offsets_user=None) -> np.ndarray:
+        """A vector from the zero offsets (file units, joint order), geometric errors by name and the MAEMM (mm).
 
         Parameters
         ----------
+        zero_offsets_user : sequence of m floats, optional
+            In the joints' file unit (deg for revolute joints, mm for prismatic ones).
         zero_offsets_deg : sequence of m floats, optional
+            The same for revolute joints (its former name).
         geometry : dict of str -> float, optional
             Geometric errors by name (mm, rad for angles).
-        maemm_mm : sequence of n floats, optional
+        maemm_mm : sequence of u floats, optional
+            The measuring errors, in their order.
         """
+        if zero_offsets_deg is not None:
+            if self.offset_unit != "rad":
+                raise ValueError("zero_offsets_deg: these zero offsets are lengths (mm): pass zero_offsets_user")
+            zero_offsets_user = zero_offsets_deg
         v = self.vector(geometry or {})
-        for names, vals, conv in ((self.zero_offsets, zero_offsets_deg, np.radians), (self.measuring, maemm_mm, np.asarray)):
+        off_conv = np.radians if self.offset_unit == "rad" else np.asarray
+        for names, vals, conv in ((self.zero_offsets, zero_offsets_user, off_conv), (self.measuring, maemm_mm, np.asarray)):
             if vals is None:
                 continue
             vals = np.asarray(vals, float)

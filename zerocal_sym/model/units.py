@@ -100,3 +100,10 @@ def pose_unit(mech, name: str) -> str:
     """File unit of the pose coordinate ``name`` (``mm`` | ``deg``)."""
     mech = getattr(mech, "mechanism", mech)
     return USER_UNIT[mech.pose_units.get(name, "mm")]
+
+
+def pose_key(mech, stem: str) -> str:
+    """``<stem>_mm`` for a pose of lengths only; ``<stem>`` for one with orientations (its units listed beside
+    it as ``pose_units``)."""
+    mech = getattr(mech, "mechanism", mech)
+    return f"{stem}_mm" if all(mech.pose_units.get(p, "mm") == "mm" for p in mech.pose_names) else stem
