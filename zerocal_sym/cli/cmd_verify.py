@@ -23,17 +23,23 @@ NAME = "verify"
 HELP = "re-identify with the compensation applied; pass if the remaining offset mu < mu0"
 
 
+#: the files ``--plot DIR`` writes into DIR
+PLOTS = ("residuals.png",)
+
+
 def add_arguments(p):
-    p.add_argument("result", metavar="RESULT.json", help="the applied result (zerocal identify --json / verify --out)")
-    p.add_argument("data", metavar="DATA.csv", help="measurements taken with that compensation applied")
+    from zerocal_sym.cli._paths import InputFile, OutputDir, OutputFile
+
+    p.add_argument("result", metavar="RESULT.json", type=InputFile("the results file"), help="the applied result (zerocal identify --json / verify --out)")
+    p.add_argument("data", metavar="DATA.csv", type=InputFile("the measurement file"), help="measurements taken with that compensation applied")
     p.add_argument("--method", choices=["tsvd", "nlls"], default="tsvd", help="identification method (default tsvd)")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
                    help="noise model for weights and covariance (default paper)")
     p.add_argument("--mu0", type=float, default=0.1, help="threshold of the compensation accuracy mu, deg (0.1)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.add_argument("--out", metavar="FILE.json", default=None,
+    p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(),
                    help="write the new result (readable by compensate and verify), atomically")
-    p.add_argument("--plot", metavar="DIR", default=None,
+    p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
                    help="write residuals.png (residuals per pose of the re-identification) into DIR")
     from zerocal_sym.cli.cmd_identify import add_trust_arguments
 
