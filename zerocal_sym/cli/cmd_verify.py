@@ -105,6 +105,14 @@ def run(args):
     joints = robot.mechanism.joint_names
     applied = load_result(args.result, robot=robot)
     check_result_robot(applied, robot, args.result)
+    from zerocal_sym.identify.fitcheck import plausibility
+
+    reasons = plausibility(robot, applied, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    if reasons:  # as compensate: not a calibration to verify (and not a prior for the re-identification)
+        import sys
+
+        print(f"zerocal verify: refused {args.result}: {'; '.join(reasons)}", file=sys.stderr)
+        return 1
     meas = load_measurements(args.data, robot)
     declared = parse_offsets(meas.meta.get("compensation_deg"), robot.m)
     if declared is not None and np.max(np.abs(declared - applied.zero_offsets_deg)) > 1e-4:
@@ -138,8 +146,6 @@ def run(args):
         if diagnosis(res):
             print(diagnosis(res), file=sys.stderr)
         return 1
-    from zerocal_sym.identify.fitcheck import plausibility
-
     reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
     if reasons:
         import sys
