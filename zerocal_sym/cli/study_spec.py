@@ -290,7 +290,7 @@ def load_spec(path) -> Study:
 
     path = Path(path)
     raw = read_toml(path, StudySpecError, "study spec")
-    where = _Where(path, path.read_text())
+    where = _Where(path, path.read_text(encoding="utf-8").removeprefix("\ufeff"))
     base = path.parent
     for k in raw:
         if k not in SPEC_KEYS:

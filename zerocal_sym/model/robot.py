@@ -310,7 +310,7 @@ def load_robot(path) -> Robot:
     """
     path = Path(path)
     keys = read_toml(path, RobotFileError, "robot file")
-    text = path.read_text(encoding="utf-8")  # for the line numbers of the keys
+    text = path.read_text(encoding="utf-8").removeprefix("\ufeff")  # for the line numbers of the keys
 
     def where(key):
         line = _line_of(text, key) if key else None
