@@ -161,7 +161,10 @@ def atomic_write_bytes(path, data: bytes) -> None:
     if names_a_directory(p):
         raise OutputError("ends in a directory separator or '.': a file name is expected", where=p)
     target = Path(landing(p))
-    st = _stat(os.fspath(target))
+    try:
+        st = _stat(os.fspath(target))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, p) from None
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise IsADirectoryError(21, "is a directory, expected a file name", p)
     if is_stream(p, st):
@@ -208,7 +211,10 @@ def _check_one(option: str, path: str, kind: str) -> None:
         raise OutputError(f"{option}: ends in a directory separator or '.', which names a directory: give a file "
                           "name", where=path)
     land = landing(path)
-    st = _stat(land)
+    try:
+        st = _stat(land)
+    except OSError as exc:
+        raise OutputError(f"{option}: {exc.strerror}", where=path) from None
     if st is None:
         parent = os.path.dirname(land)
         while parent and not os.path.exists(parent):  # the nearest existing ancestor must be a directory
@@ -272,15 +278,19 @@ def check_outputs(outputs, inputs=()) -> None:
         socket; an output that lands on an input (:func:`landing`, and the
         same device and inode) or on another output.
     """
-    ins = []
+    ins, by_land, by_inode = [], {}, {}
     for label, path in inputs:
         if path is None or os.fspath(path) == "":
             continue
         path = os.fspath(path)
         land = landing(path)
-        st = _stat(land)
+        try:
+            st = _stat(land)
+        except OSError:  # unreadable: its loader says so
+            continue
         if st is not None and stat.S_ISREG(st.st_mode):
-            ins.append((label, path, land, st))
+            ins.append((label, path, land))
+            by_land[land] = by_inode[(st.st_dev, st.st_ino)] = (label, path)
     files = []  # (option, user path, landing)
     for item in outputs:
         option, path = item[0], item[1]
@@ -295,23 +305,30 @@ def check_outputs(outputs, inputs=()) -> None:
             continue
         files += [(option, user, land) for land, user in _written_in(path, names)]
         dland = landing(path)
-        for label, ipath, iland, _ in ins:  # an input below the directory, under a name it writes
+        for label, ipath, iland in ins:  # an input below the directory, under a name it writes
             rel = os.path.relpath(iland, dland)
-            if not rel.startswith(os.pardir) and any(_matches(rel, pat) for pat in names):
+            if rel != os.pardir and not rel.startswith(os.pardir + os.sep) and any(_matches(rel, pat)
+                                                                                for pat in names):
                 raise OutputError(f"{option} would overwrite {ipath}, {label}: an input is never overwritten; "
                                   "write the output elsewhere", where=path)
-    seen = []
+    seen_land, seen_inode = {}, {}  # of the outputs: -> (option, user path)
     for option, user, land in files:
-        st = _stat(land)
-        for label, ipath, iland, ist in ins:
-            if land == iland or (st is not None and os.path.samestat(st, ist)):
-                raise OutputError(f"{option} would overwrite {ipath}, {label}: an input is never overwritten; "
-                                  "write the output elsewhere", where=user)
-        for other_option, other_user, other_land, other_st in seen:
-            if land == other_land or (st is not None and other_st is not None and os.path.samestat(st, other_st)):
-                raise OutputError(f"{option} and {other_option} name the same file ({other_user}): give two "
-                                  "different outputs", where=user)
-        seen.append((option, user, land, st))
+        try:
+            st = _stat(land)
+        except OSError as exc:
+            raise OutputError(f"{option}: {exc.strerror}", where=user) from None
+        inode = None if st is None else (st.st_dev, st.st_ino)
+        hit = by_land.get(land) or by_inode.get(inode)
+        if hit is not None:
+            raise OutputError(f"{option} would overwrite {hit[1]}, {hit[0]}: an input is never overwritten; "
+                              "write the output elsewhere", where=user)
+        other = seen_land.get(land) or seen_inode.get(inode)
+        if other is not None and other[0] != option:
+            raise OutputError(f"{option} and {other[0]} name the same file ({other[1]}): give two different "
+                              "outputs", where=user)
+        seen_land.setdefault(land, (option, user))
+        if inode is not None:
+            seen_inode.setdefault(inode, (option, user))
 
 
 @contextlib.contextmanager
@@ -334,7 +351,10 @@ def staged_directory(path):
     if p == "":
         raise OutputError("empty directory name")
     out = Path(landing(p))
-    st = _stat(os.fspath(out))
+    try:
+        st = _stat(os.fspath(out))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, p) from None
     if st is not None and not stat.S_ISDIR(st.st_mode):
         raise OutputError(f"is {_kind(st.st_mode)}, not a directory", where=p)
     created = []

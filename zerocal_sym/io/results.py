@@ -33,6 +33,8 @@ import numpy as np
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import _json_line, _load_json, _read_text, get_mechanism_of, mechanism_for_shape
 
+#: the sign convention of every file that carries offsets (a results file's ``compensation.sign_convention``)
+SIGN_CONVENTION = "theta_cmd = IK(P) - offset_deg (actual joint angle = commanded + offset)"
 #: the unit of the zero offsets at the file edge: every key that names them is made from it here
 OFFSET_UNIT = "deg"
 OFFSETS_KEY = f"zero_offsets_{OFFSET_UNIT}"
@@ -251,8 +253,6 @@ def _compensation(obj, names, off, std, joints, text, src) -> np.ndarray:
 
     Returns ``std`` with the block's ``std_deg`` merged in (:func:`_merge`).
     """
-    from zerocal_sym.io.compensation import SIGN_CONVENTION
-
     c = obj.get("compensation")
     if c is None:
         return std
