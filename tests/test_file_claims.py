@@ -244,3 +244,11 @@ def test_verify_names_an_implausible_maemm_of_the_applied_result(capsys, tmp_pat
     err = capsys.readouterr().err
     assert rc == 1 and err.startswith(f"zerocal verify: refused {p}: MAEMM |rM| = 1.414e+12 mm is beyond"), err
     assert "rank" not in err and not (tmp_path / "new.json").exists()
+
+
+def test_identify_names_an_implausible_maemm_prior(capsys, made):
+    """A MAEMM prior that --max-maemm-mm would refuse is named as such before any work, not left to the fit."""
+    refused(capsys, ["identify", made["data"], "--method", "tsvd", "--maemm-prior", "300", "0"],
+            r"--maemm-prior 300 0: \|rM\| = 300 mm is beyond --max-maemm-mm 50")
+    assert main(["identify", str(made["data"]), "--method", "tsvd", "--noise", "none", "--maemm-prior", "300", "0",
+                 "--max-maemm-mm", "400"]) in (0, 1)

@@ -150,6 +150,18 @@ def _trust(args) -> None:
     _positive(args, "max_maemm_mm", " of mm")
 
 
+def _prior_within_plausible(args) -> None:
+    """A MAEMM prior the plausibility check (``--max-maemm-mm``) would refuse is an error now, naming the prior."""
+    v, limit = getattr(args, "maemm_prior", None), getattr(args, "max_maemm_mm", None)
+    if v is None or limit is None or not all(math.isfinite(x) for x in v):
+        return
+    norm = math.sqrt(sum(x * x for x in v))
+    if norm > limit:
+        raise ZerocalError(f"--maemm-prior {' '.join(f'{x:g}' for x in v)}: |rM| = {norm:.4g} mm is beyond "
+                           f"--max-maemm-mm {limit:g}: a result near this prior would be refused as implausible "
+                           "(a MAEMM that large is a wrong c / d in the robot file)")
+
+
 def _identify(args) -> None:
     _trust(args)
     if args.method == "tsvd":
@@ -169,6 +181,7 @@ def _identify(args) -> None:
         if args.max_iter is not None and args.max_iter < 1:
             raise ZerocalError(f"--max-iter must be >= 1, got {args.max_iter}")
     _maemm_prior(args)
+    _prior_within_plausible(args)
     if args.report and args.json:
         raise ZerocalError("--report is for the text output: the JSON (--json) holds the report under "
                            "'identifiability'")
