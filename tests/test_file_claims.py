@@ -161,7 +161,9 @@ def test_two_robot_hashes_that_disagree_are_refused(capsys, tmp_path, made):
 
 def test_a_result_of_another_robot_is_refused_with_a_valid_hash(capsys, tmp_path, made):
     other = "0" * 64
-    p = edited(made, tmp_path, lambda o: (o.__setitem__("robot_sha256", other), o["robot"].__setitem__("sha256", other)))
+    def change(o):
+        o["robot_sha256"] = o["robot"]["sha256"] = other
+    p = edited(made, tmp_path, change)
     refused(capsys, ["compensate", p], r"identified on another robot")
 
 

@@ -64,7 +64,10 @@ class OutputFile(PathType):
 
 
 class OutputDir(PathType):
-    """A directory the command writes into: ``names`` are the files it writes there (``fnmatch`` patterns, ``/`` between levels)."""
+    """A directory the command writes into.
+
+    ``names``: the files it writes there (``fnmatch`` patterns, ``/`` between levels).
+    """
 
     kind = "output directory"
 
@@ -85,7 +88,7 @@ def path_options(parser: argparse.ArgumentParser) -> list:
 
 
 def given_paths(args, options=None) -> tuple:
-    """``(inputs, outputs)`` of the parsed ``args``: ``[(option, label, path)]`` and ``[(option, path[, names])]``.
+    """``(inputs, outputs)`` of ``args``: ``[(option, label, path, is_dir)]``, ``[(option, path[, names])]``.
 
     ``options``: :func:`path_options` of the command's parser (default: those
     recorded on ``args`` by :func:`zerocal_sym.cli.build_parser`).

@@ -205,7 +205,8 @@ def _by_name(obj, key, mech, text, src, kind):
             want = (mech.errors[name].user_unit,) if mech is not None else ("deg", "mm")
             if x not in want:
                 raise DataFileError(f"key '{key}': the unit of {name!r} must be "
-                                    f"{' or '.join(json.dumps(w) for w in want)}, got {json.dumps(x)[:30]}", where=where)
+                                    f"{' or '.join(json.dumps(w) for w in want)}, got {json.dumps(x)[:30]}",
+                                    where=where)
             out[name] = x
             continue
         if x is None and kind == "std":
@@ -236,8 +237,9 @@ def _merge(copy_key, copy: dict, key, names, values, text, src) -> np.ndarray:
         if math.isnan(out[j]):
             out[j] = c
         elif not math.isclose(c, out[j], rel_tol=SAME_VALUE_TOL, abs_tol=SAME_VALUE_TOL):
-            raise DataFileError(f"key '{copy_key}': {name} = {float(c)!r} disagrees with '{key}' ({float(out[j])!r}): one of the "
-                                "two copies was edited; make them the same", where=_where(text, copy_key, src))
+            raise DataFileError(f"key '{copy_key}': {name} = {float(c)!r} disagrees with '{key}' ({float(out[j])!r}): "
+                                "one of the two copies was edited; make them the same",
+                                where=_where(text, copy_key, src))
     return out
 
 
