@@ -70,6 +70,8 @@ class Rectangle(_Shape):
     kind = "rectangle"
     keys = ("H", "b", "h")
     sizes = ("b", "h")
+    #: keys that are distances from the base, positive (the workspace is on the side the mechanism works)
+    distances = ("H",)
     n = 2
     scheme_name = "paper"
 
@@ -164,6 +166,11 @@ class Cylinder(_Shape):
     def sizes(self) -> tuple:
         return tuple(k for k in ("rw", "h") if k in dict(self.given)) + (
             ("height",) if "z_min" in dict(self.given) else ())
+
+    @property
+    def distances(self) -> tuple:
+        """Keys that are distances from the base, positive: ``H`` (the workspace below the base), when given."""
+        return ("H",) if "H" in dict(self.given) else ()
 
     @property
     def height(self) -> float:
