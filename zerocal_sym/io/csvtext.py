@@ -295,14 +295,21 @@ def registered_mechanisms() -> list:
     return [get_mechanism(k) for k in sorted(REGISTRY, key=lambda k: k != DEFAULT_MECHANISM)]
 
 
-def joint_columns(mech, suffix: str = "_deg") -> tuple:
-    """``theta1_deg, ...``: one column per joint of ``mech`` (a name, Mechanism or Robot)."""
-    return tuple(j + suffix for j in get_mechanism_of(mech).joint_names)
+def joint_columns(mech, suffix: str | None = None) -> tuple:
+    """``theta1_deg, ...`` (revolute joints) or ``s1_mm, ...`` (prismatic): one column per joint of ``mech`` (a
+    name, Mechanism or Robot), the suffix its joints' unit."""
+    mech = get_mechanism_of(mech)
+    suffix = "_" + mech.joint_user_unit if suffix is None else suffix
+    return tuple(j + suffix for j in mech.joint_names)
 
 
 def pose_columns(mech) -> tuple:
-    """``x_mm, y_mm[, z_mm]``: one column per pose coordinate of ``mech`` (a name, Mechanism or Robot)."""
-    return tuple(p + "_mm" for p in get_mechanism_of(mech).pose_names)
+    """``x_mm, y_mm[, z_mm]`` (and ``roll_deg, ...`` for orientations): one column per pose coordinate of
+    ``mech`` (a name, Mechanism or Robot), the suffix its unit."""
+    from zerocal_sym.model.units import pose_unit
+
+    mech = get_mechanism_of(mech)
+    return tuple(f"{p}_{pose_unit(mech, p)}" for p in mech.pose_names)
 
 
 def infer_mechanism(header, joints: bool = True):

@@ -22,6 +22,7 @@ from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import MECHANISM_KEY, infer_mechanism
 from zerocal_sym.io.duplicates import first_duplicate
 from zerocal_sym.io.measurement_columns import MeasurementColumns, measurement_columns
+from zerocal_sym.model import units
 from zerocal_sym.model.measurements import Measurements
 
 #: commanded poses farther than this outside the workspace are rejected (mm);
@@ -44,23 +45,25 @@ def _check_metadata(meta, meta_lines, src, mech) -> None:
     if sha is not None and not SHA256_RE.fullmatch(sha):
         raise DataFileError(f"'# robot_sha256:' must be the robot's SHA-256, 64 hexadecimal digits ('zerocal robot' "
                             f"prints it), got {sha[:80]!r}", where=f"{src}:{meta_lines['robot_sha256']}")
-    comp = meta.get("compensation_deg")
+    key = units.joint_key(mech, "compensation")
+    comp = meta.get(key)
     if comp is not None and parse_offsets(comp, mech.m) is None:
-        raise DataFileError(f"'# compensation_deg:' must be {mech.m} finite angles in deg, one per joint "
-                            f"({', '.join(mech.joint_names)}), got {comp[:80]!r}",
-                            where=f"{src}:{meta_lines['compensation_deg']}")
+        raise DataFileError(f"'# {key}:' must be {mech.m} finite joint offsets in {mech.joint_user_unit}, one per "
+                            f"joint ({', '.join(mech.joint_names)}), got {comp[:80]!r}",
+                            where=f"{src}:{meta_lines[key]}")
 
 
 def _declared_mechanism(meta, meta_lines, src, robot):
     """The file's ``# mechanism:`` (None without); unknown or not the robot's: DataFileError."""
-    from zerocal_sym.model.mechanism import REGISTRY
+    from zerocal_sym.model.mechanism import known_mechanisms
 
     declared = meta.get(MECHANISM_KEY)
     if declared is None:
         return None
     where = f"{src}:{meta_lines[MECHANISM_KEY]}"
-    if declared not in REGISTRY:
-        raise DataFileError(f"unknown mechanism {declared!r} (known: {', '.join(REGISTRY)})", where=where)
+    known = known_mechanisms()
+    if declared not in known and (robot is None or declared != robot.mechanism_name):
+        raise DataFileError(f"unknown mechanism {declared!r} (known: {', '.join(known)})", where=where)
     if robot is not None and declared != robot.mechanism_name:
         raise DataFileError(f"measured with mechanism {declared}, the robot file is {robot.mechanism_name} "
                             f"({robot.source}): pass the robot file of the measured robot", where=where)
@@ -80,9 +83,17 @@ def _check_columns_fit_robot(header, where, robot) -> None:
                             "the measured robot", where=where)
 
 
+def _joint_unit(meas) -> str:
+    """Internal unit of the measured joints (the file's mechanism's; rad when it names none)."""
+    from zerocal_sym.model.mechanism import get_mechanism, known_mechanisms
+
+    name = meas.mechanism
+    return get_mechanism(name).joint_unit if name in known_mechanisms() else "rad"
+
+
 def _check_duplicates(meas: Measurements, cols: MeasurementColumns) -> None:
-    """A pose that repeats an earlier one (commanded angles to 1e-9 deg, or the target to 1e-9 mm)."""
-    found = [("angles", first_duplicate(np.degrees(meas.theta_cmd), DUPLICATE_TOL_DEG))]
+    """A pose that repeats an earlier one (commanded joints to 1e-9 in their file unit, or the target to 1e-9)."""
+    found = [("angles", first_duplicate(units.to_user(meas.theta_cmd, _joint_unit(meas)), DUPLICATE_TOL_DEG))]
     if meas.target is not None:
         found.append(("target", first_duplicate(meas.target, 1e-9)))
     found = [(kj, what) for what, kj in found if kj is not None]
@@ -106,7 +117,7 @@ def check_against_robot(meas: Measurements, robot) -> None:
     DataFileError
     """
     from zerocal_sym.model import kinematics as kin
-    from zerocal_sym.model.kinematics import fmt_pose
+    from zerocal_sym.model.kinematics import fmt_pose, fmt_user_pose
 
     line = meas.meta_lines.get(MECHANISM_KEY)
     if meas.mechanism is not None and meas.mechanism != robot.mechanism_name:
@@ -134,20 +145,23 @@ def check_against_robot(meas: Measurements, robot) -> None:
             bad |= ~ws.contains(meas.target, 1e-6) | ~(np.linalg.norm(P - meas.target, axis=1) <= TARGET_TOL_MM)
     for k in map(int, np.flatnonzero(bad)[:1]):
         if not np.all(np.isfinite(P[k])):
-            raise DataFileError(f"commanded joint angles {fmt_pose(np.degrees(meas.theta_cmd[k]))} deg are not an "
-                                "assembly of the robot (unreachable pose; angles in degrees?)", where=meas.where(k))
+            ju = robot.mechanism.joint_user_unit
+            raise DataFileError(f"commanded {units.joint_noun(robot)} "
+                                f"{fmt_pose(units.joints_to_user(robot, meas.theta_cmd[k]))} {ju} are not an "
+                                f"assembly of the robot (unreachable pose; {units.unit_hint(robot)})",
+                                where=meas.where(k))
         pts = [("commanded", P[k], WORKSPACE_TOL_MM)]
         if meas.target is not None:
             pts.append((target_what, meas.target[k], 1e-6))
         for what, p, tol in pts:
             if not ws.contains(p, tol)[0]:
                 raise DataFileError(
-                    f"{what} pose {fmt_pose(p, '.3f')} mm is outside the workspace {ws.describe()} "
+                    f"{what} pose {fmt_user_pose(robot, p, '.3f')} is outside the workspace {ws.describe()} "
                     f"(tolerance {tol:g} mm)", where=meas.where(k))
         if meas.target is not None:
             dist = float(np.linalg.norm(P[k] - meas.target[k]))
             if dist > TARGET_TOL_MM:
                 raise DataFileError(
-                    f"the commanded joint angles reach {fmt_pose(P[k], '.3f')} mm, {dist:.1f} mm from the "
-                    f"target {fmt_pose(meas.target[k])} mm (more than {TARGET_TOL_MM:g} mm: "
-                    "columns swapped, or angles not in degrees?)", where=meas.where(k))
+                    f"the commanded {units.joint_noun(robot)} reach {fmt_user_pose(robot, P[k], '.3f')}, {dist:.1f} mm "
+                    f"from the target {fmt_user_pose(robot, meas.target[k])} (more than {TARGET_TOL_MM:g} mm: "
+                    f"columns swapped, or {units.joint_noun(robot).split()[1]} not in {robot.mechanism.joint_user_unit}?)", where=meas.where(k))

@@ -50,6 +50,8 @@ import io
 
 import numpy as np
 
+from zerocal_sym.model import units
+
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import (MECHANISM_KEY, _check_header, _check_pose_numbers, _format_meta, _go_together,
                                     _read_text, _rows_to_array, _split_csv, get_mechanism_of, infer_mechanism,
@@ -125,9 +127,10 @@ def _write(theta_cmd, readings, target, meta, mech, first_meta=None) -> str:
     buf.write(_format_meta({MECHANISM_KEY: mech.name, **(first_meta or {}), **meta}))
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(cols.header(target is not None))
-    deg = np.degrees(theta_cmd)
+    user = units.joints_to_user(mech, theta_cmd)
+    target = None if target is None else units.pose_to_user(mech, target)
     for k in range(theta_cmd.shape[0]):
-        row = [k] + [repr(float(v)) for v in deg[k]]
+        row = [k] + [repr(float(v)) for v in user[k]]
         row.append(("0" if k == 0 else "") if readings is None else repr(float(readings[k])))
         if target is not None:
             row += [repr(float(v)) for v in target[k]]
@@ -251,9 +254,9 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
         raise DataFileError(f"column 'reading_mm' (field {col['reading_mm'] + 1}): the reading at pose 0 "
                             f"must be 0 (the head is reset there), got {V[0, col['reading_mm']]:g}",
                             where=f"{src}:{lines[0]}")
-    theta = np.radians(V[:, [col[c] for c in cols.joints]])
+    theta = units.joints_from_user(mech, V[:, [col[c] for c in cols.joints]])
     readings = V[:, col["reading_mm"]].copy()
-    target = V[:, [col[c] for c in cols.pose]] if all(has_pose) else None
+    target = units.pose_from_user(mech, V[:, [col[c] for c in cols.pose]]) if all(has_pose) else None
     meas = Measurements(theta, readings, target, meta, src, lines, meta_lines, mech.name)
     if K < min_poses:
         raise DataFileError(f"too few poses: {K} (at least {min_poses} are needed to identify the parameters)",

@@ -431,7 +431,7 @@ def validate(robot: Robot, where=None) -> dict:
     RobotFileError
     """
     from zerocal_sym.errors import PoseError
-    from zerocal_sym.model.kinematics import fk, ik, ik_ratio, transmission
+    from zerocal_sym.model.kinematics import fk, fmt_user_pose, ik, ik_ratio, transmission
 
     where = where or (lambda key: robot.source)
     mech = robot.mechanism
@@ -473,7 +473,7 @@ def validate(robot: Robot, where=None) -> dict:
     for (label, p), th, ok in zip(corners.items(), th_c, np.all(np.abs(ratio) <= 1, axis=1) & np.all(
             np.isfinite(th_c), axis=1)):
         if not ok:
-            raise RobotFileError(f"workspace corner {label} = {fmt(units.pose_to_user(robot, p))} is unreachable "
+            raise RobotFileError(f"workspace corner {label} = {fmt_user_pose(robot, p)} is unreachable "
                                  "(a limb cannot close, or a joint is beyond its travel)", where=robot.source)
         summary["corners"][label] = {units.pose_key(robot, "pose"): units.pose_to_user(robot, p).tolist(),
                                      jkey: units.joints_to_user(robot, th).tolist()}
@@ -486,7 +486,7 @@ def validate(robot: Robot, where=None) -> dict:
     dev = np.linalg.norm(back - grid, axis=1)
     bad = np.flatnonzero(~(dev < 1e-6))
     if bad.size:
-        raise RobotFileError(f"forward and inverse kinematics disagree at {fmt(units.pose_to_user(robot, grid[bad[0]]))}: "
+        raise RobotFileError(f"forward and inverse kinematics disagree at {fmt_user_pose(robot, grid[bad[0]])}: "
                              "the workspace crosses an assembly-mode change (or the forward kinematics' solve "
                              "does not converge there)", where=robot.source)
     s = np.abs(transmission(robot, grid, th))
@@ -494,7 +494,7 @@ def validate(robot: Robot, where=None) -> dict:
     smin = float(np.min(s[k]))
     if smin < robot.singularity_margin:
         raise RobotFileError(
-            f"configuration near-singular at {fmt(grid[k])} mm: min |singularity indicator| "
+            f"configuration near-singular at {fmt_user_pose(robot, grid[k])}: min |singularity indicator| "
             f"(sine of a transmission angle) = {smin:.3g} < singularity_margin {robot.singularity_margin:g}",
             where=robot.source)
     home = robot.home_pose()

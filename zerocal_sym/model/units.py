@@ -107,3 +107,18 @@ def pose_key(mech, stem: str) -> str:
     it as ``pose_units``)."""
     mech = getattr(mech, "mechanism", mech)
     return f"{stem}_mm" if all(mech.pose_units.get(p, "mm") == "mm" for p in mech.pose_names) else stem
+
+
+#: what the joint variables of a kind are called in messages
+JOINT_NOUN = {"revolute": "joint angles", "prismatic": "joint positions"}
+
+
+def joint_noun(mech) -> str:
+    """``joint angles`` (revolute) or ``joint positions`` (prismatic), for messages."""
+    return JOINT_NOUN[getattr(mech, "mechanism", mech).joint_kind]
+
+
+def unit_hint(mech) -> str:
+    """``angles in degrees?`` or ``positions in mm?``: what to check when joints look wrong."""
+    mech = getattr(mech, "mechanism", mech)
+    return "angles in degrees?" if mech.joint_kind == "revolute" else "positions in mm?"
