@@ -147,6 +147,7 @@ def _trust(args) -> None:
         raise ZerocalError(f"--fit-alpha must be a significance level in (0, 1), got {a:g}")
     _positive(args, "loss_scale", " (standard deviations of a reading)")
     _positive(args, "max_offset_deg", " of degrees")
+    _positive(args, "max_offset", " (in the joints' unit)")
     _positive(args, "max_maemm_mm", " of mm")
 
 
@@ -175,7 +176,7 @@ def _identify(args) -> None:
             raise ZerocalError("--rule discrepancy needs the noise level: not with --noise none (give --noise "
                                "paper|scale-only|servo-only, or another --rule)")
     else:
-        bad = _given(args, "truncation", "rule")
+        bad = _given(args, "truncation", "rule", "iterate")
         if bad:
             raise ZerocalError(f"{_opts(bad)}: for --method tsvd only")
         if args.max_iter is not None and args.max_iter < 1:
@@ -188,11 +189,14 @@ def _identify(args) -> None:
 
 
 def _compensate(args) -> None:
-    if args.result is None and _given(args, "max_offset_deg"):
-        raise ZerocalError("--max-offset-deg checks the offsets of RESULT.json: give the result (without one "
+    bad = _given(args, "max_offset_deg", "max_offset")
+    if args.result is None and bad:
+        raise ZerocalError(f"{_opts(bad)} checks the offsets of RESULT.json: give the result (without one "
                            "there is no offset to check)")
     if args.max_offset_deg is not None:
         _positive(args, "max_offset_deg", " of degrees")
+    if args.max_offset is not None:
+        _positive(args, "max_offset", " (in the joints' unit)")
     _n(args)
 
 

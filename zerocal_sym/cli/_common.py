@@ -14,7 +14,7 @@ import math
 #: (its eps rule's choice, Section 5); the ring scheme's n = 6 (DELTA.md: n = 4
 #: is the fewest that identify the Delta's 6 parameters, but cond(G) = 3186
 #: there; 233 at n = 6).  A scheme not listed: the fewest that identify.
-DEFAULT_N = {"paper": 3, "ring": 6}
+DEFAULT_N = {"paper": 3, "ring": 6, "corners": 64}
 
 
 def scheme_names() -> tuple:
@@ -25,13 +25,13 @@ def scheme_names() -> tuple:
 
 
 def n_params(robot) -> int:
-    """p = m + n: the paper's identification parameters (zero offsets and MAEMM)."""
+    """p: the mechanism's identified set (the paper's: the zero offsets and the MAEMM, m + n)."""
     return len(robot.errors.resolve("default"))
 
 
 def min_n(robot) -> int:
-    """Fewest poses per boundary whose K - 1 = 2n - 1 changes can identify the p = m + n parameters."""
-    return max(2, math.ceil((n_params(robot) + 1) / 2))
+    """The smallest scheme parameter n whose K - 1 changes can identify the p parameters (K = 2n, or n corners)."""
+    return robot.workspace.min_scheme_n(n_params(robot))
 
 
 def default_n(robot) -> int:
@@ -73,9 +73,10 @@ def scheme_poses(robot, scheme=None, n=None, identifiable: bool = True, option: 
     check_scheme(robot, scheme, option)
     n = default_n(robot) if n is None else int(n)
     p = n_params(robot)
-    if identifiable and 2 * n - 1 < p:
-        raise PoseError(f"--n {n} gives K = {2 * n} poses, {2 * n - 1} measured changes: too few to identify the "
-                        f"{p} parameters ({', '.join(robot.errors.resolve('offsets+measuring'))}); "
+    K = robot.workspace.scheme_size(n)
+    if identifiable and K - 1 < p:
+        raise PoseError(f"--n {n} gives K = {K} poses, {K - 1} measured changes: too few to identify the "
+                        f"{p} parameters ({', '.join(robot.errors.resolve('default'))}); "
                         f"n >= {min_n(robot)} needed")
     return robot.workspace.boundary_scheme(n), n
 
@@ -130,7 +131,10 @@ def check_round_poses(robot, P, theta_cmd, source: str) -> None:
     except PoseError as exc:
         raise PoseError(f"{exc.where}: {exc.message} ({why})" if exc.where else f"{exc.message} ({why})",
                         where=source) from None
-    for what, X, tol in (("commanded joint angles", np.degrees(theta_cmd), 1e-9), ("target", P, 1e-9)):
+    from zerocal_sym.model import units
+
+    for what, X, tol in ((f"commanded {units.joint_noun(robot)}", units.joints_to_user(robot, theta_cmd), 1e-9),
+                         ("target", P, 1e-9)):
         dup = first_duplicate(X, tol)
         if dup is not None:
             k, j = dup

@@ -49,7 +49,7 @@ def add_arguments(p):
     g.add_argument("--group", type=int, default=None,
                    help="Table 2 group 1..6 (the paper's robot only; its default: 1)")
     g.add_argument("--all", action="store_true", help="all six groups of Table 2 (the paper's robot only)")
-    p.add_argument("--poses", default=None, metavar="paper|ring|FILE", type=InputFile("the pose file", not_files=scheme_names),
+    p.add_argument("--poses", default=None, metavar="paper|ring|corners|FILE", type=InputFile("the pose file", not_files=scheme_names),
                    help="measurement poses: the robot's scheme (default; with --n) or a pose file "
                         "[pose,]x_mm,y_mm[,z_mm]")
     p.add_argument("--n", type=int, default=None, help="poses per boundary of the scheme (default: 3 paper, 6 ring)")
@@ -78,7 +78,8 @@ def add_arguments(p):
 def run(args):
     from zerocal_sym.cli import _parallel, load_robot_arg
     from zerocal_sym.cli._checks import PARAM_METHODS
-    from zerocal_sym.cli._common import has_paper_tables, parse_named_values, poses_arg, require_paper_tables
+    from zerocal_sym.cli._common import (has_paper_tables, parse_named_values, poses_arg, require_paper_tables,
+                                         scheme_names)
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.identify.montecarlo import format_compare
     from zerocal_sym.io.files import to_json, write_json
@@ -100,7 +101,7 @@ def run(args):
         if args.frame is not None or args.no_geometric:
             raise ZerocalError("--frame and --no-geometric are for Table 2 (--group/--all), not --set")
         truth = robot.errors.from_user(parse_named_values(args.set, robot, "--set"))
-    if args.n is not None and args.poses is not None and args.poses not in ("paper", "ring"):
+    if args.n is not None and args.poses is not None and args.poses not in scheme_names():
         raise ZerocalError("--n is the number of poses per boundary of a scheme: not with a pose file")
     poses, _ = poses_arg(robot, args.poses, args.n)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -112,7 +113,7 @@ def run(args):
         from zerocal_sym.cli._checks import identifiability_problem
         from zerocal_sym.model import kinematics as kin
 
-        of = (f" of --poses {args.poses}" if args.poses not in (None, "paper", "ring")
+        of = (f" of --poses {args.poses}" if args.poses not in (None, *scheme_names())
               else f" of --n {args.n}" if args.n is not None else "")
         problem = identifiability_problem(robot, kin.check_poses(robot, poses), params,
                                           poses=f"the {len(poses)} poses{of}")

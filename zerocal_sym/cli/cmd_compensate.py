@@ -36,14 +36,17 @@ def add_arguments(p):
     g = p.add_mutually_exclusive_group()
     g.add_argument("--poses", metavar="FILE.csv", default=None, type=InputFile("the pose file"),
                    help="target positions: CSV [pose,]x_mm,y_mm[,z_mm] or design JSON")
-    g.add_argument("--scheme", choices=["paper", "ring"], default=None,
-                   help="the robot's boundary scheme, 2n poses (paper: rectangle, ring: cylinder)")
+    g.add_argument("--scheme", choices=["paper", "ring", "corners"], default=None,
+                   help="the robot's boundary scheme (paper: rectangle, ring: cylinder, 2n poses; corners: 6-D box, n)")
     p.add_argument("--n", type=int, default=None,
-                   help="poses per boundary for --scheme (default: 3 paper, 6 ring)")
+                   help="the size of --scheme: poses per boundary (default: 3 paper, 6 ring) or corners (16, 32, 64; default 64)")
     p.add_argument("--template", action="store_true",
                    help="write a measurement file to fill in (reading_mm blank) instead of a command table")
-    p.add_argument("--max-offset-deg", type=float, default=10.0,
-                   help="refuse offsets larger than this (default 10 deg: not a zero offset)")
+    p.add_argument("--max-offset", type=float, default=None, metavar="X",
+                   help="refuse offsets larger than this, in the joints' unit: deg for revolute, mm for prismatic "
+                        "joints (default 10 deg or 10 mm: not a zero offset)")
+    p.add_argument("--max-offset-deg", type=float, default=None, metavar="DEG",
+                   help="the same for revolute joints, in deg (the former spelling)")
     p.add_argument("--out", metavar="FILE.csv", default=None, type=OutputFile(), help="output file (default: print)")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
 
@@ -66,8 +69,9 @@ def run(args):
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.cli._common import check_round_poses, scheme_poses
     from zerocal_sym.errors import DataFileError, ZerocalError
-    from zerocal_sym.io.compensation import (SIGN_CONVENTION, compensated_commands, format_commands,
-                                             format_compensation, format_offsets)
+    from zerocal_sym.io.compensation import compensated_commands, format_commands, format_compensation, format_offsets
+    from zerocal_sym.io.results import sign_convention
+    from zerocal_sym.model import units
     from zerocal_sym.io.files import atomic_write_text, to_json
     from zerocal_sym.io.measurements import format_template
     from zerocal_sym.io.poses import load_poses
@@ -85,15 +89,16 @@ def run(args):
     if args.n is not None and args.scheme is None:
         raise ZerocalError("--n is the number of poses per boundary of --scheme")
     if args.result is not None:
+        from zerocal_sym.cli.cmd_identify import max_offset_arg
         from zerocal_sym.identify.fitcheck import plausibility
 
         res = load_result(args.result, allow_failed=True, robot=robot)
         check_result_robot(res, robot, args.result)
-        reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg)
+        reasons = plausibility(robot, res, max_offset=max_offset_arg(args, robot))
         if reasons:  # not a calibration: refused (exit 1), nothing written
             print(f"zerocal compensate: refused {args.result}: {'; '.join(reasons)}", file=sys.stderr)
             return 1
-        offsets = res.zero_offsets_deg
+        offsets = res.zero_offsets_user
     else:
         res, offsets = None, np.zeros(robot.m)
     meta = {"robot_sha256": robot.sha256}
@@ -111,7 +116,7 @@ def run(args):
         K = len(P)
         if args.template:  # a round identify would refuse is refused now, not after the measurements
             check_round_poses(robot, P, cmd, source)
-            meta["compensation_deg"] = format_offsets(offsets)
+            meta[units.joint_key(robot, "compensation")] = format_offsets(offsets)
             text, what = format_template(cmd, P, meta, mechanism=robot), "measurement template"
         else:
             text, what = format_commands(P, nominal, cmd, offsets, meta, mechanism=robot), "compensated commands"
@@ -121,13 +126,13 @@ def run(args):
         except OSError as exc:
             raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=args.out) from None
     if args.json:
-        print(to_json({"zero_offsets_deg": [float(v) for v in offsets], "joints": list(joints),
-                       "mechanism": robot.mechanism_name, "sign_convention": SIGN_CONVENTION,
+        print(to_json({units.joint_key(robot, "zero_offsets"): [float(v) for v in offsets], "joints": list(joints),
+                       "mechanism": robot.mechanism_name, "sign_convention": sign_convention(units.joint_unit(robot)),
                        "output": args.out, "kind": what, "poses": K}))
     elif args.out:
         print(f"wrote {what} ({K} poses) to {args.out}" if K else f"wrote {what} to {args.out}")
-        print("offsets [deg]: " + ", ".join(f"{j} {v:+.6f}" for j, v in zip(joints, offsets))
-              + f"; {SIGN_CONVENTION}")
+        print(f"offsets [{units.joint_unit(robot)}]: " + ", ".join(f"{j} {v:+.6f}" for j, v in zip(joints, offsets))
+              + f"; {sign_convention(units.joint_unit(robot))}")
     else:
         print(text, end="")
     return 0

@@ -29,7 +29,7 @@ HELP = "measurement poses: the robot's boundary scheme (paper, ring) or an optim
 def add_arguments(p):
     from zerocal_sym.cli._paths import OutputFile
 
-    p.add_argument("--scheme", choices=["paper", "ring"], default=None,
+    p.add_argument("--scheme", choices=["paper", "ring", "corners"], default=None,
                    help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
     p.add_argument("--n", type=int, default=None,
                    help="poses per boundary; default: the eps0 rule (paper), 6 (ring)")

@@ -59,6 +59,9 @@ def add_arguments(p):
                    help="tsvd: fixed truncation level 1..m+n")
     p.add_argument("--rule", choices=["threshold", "gcv", "discrepancy"], default=None,
                    help="tsvd truncation rule (default: tsvd's default)")
+    p.add_argument("--iterate", type=int, nargs="?", const=20, default=None, metavar="N",
+                   help="tsvd: relinearise at the estimate until the increment is below 1e-10 (rad, mm), at most N "
+                        "steps (20 without N); default one step, the paper's")
     p.add_argument("--report", action="store_true", help="also print the identifiability report (text output)")
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
                    help="tolerance of a source error left out of the identification (mm; deg for angles), for the "
@@ -86,10 +89,32 @@ def add_trust_arguments(p, nlls_default=True):
                    help="nlls: robust loss (default l2); outlying readings are named and left out")
     p.add_argument("--loss-scale", type=float, default=None, metavar="S",
                    help="nlls: scale of the robust loss, in standard deviations of a reading")
-    p.add_argument("--max-offset-deg", type=float, default=10.0, metavar="DEG",
-                   help="refuse a result with a zero offset beyond this (default 10 deg)")
+    p.add_argument("--max-offset", type=float, default=None, metavar="X",
+                   help="refuse a result with a zero offset beyond this, in the joints' unit: deg for revolute, mm "
+                        "for prismatic joints (default 10 deg or 10 mm)")
+    p.add_argument("--max-offset-deg", type=float, default=None, metavar="DEG",
+                   help="the same for revolute joints, in deg (the former spelling)")
     p.add_argument("--max-maemm-mm", type=float, default=50.0, metavar="MM",
                    help="refuse a result with a MAEMM norm beyond this (default 50 mm)")
+
+
+def max_offset_arg(args, robot):
+    """``--max-offset`` (the joints' unit) or ``--max-offset-deg`` (revolute joints): None for the default.
+
+    Raises
+    ------
+    ZerocalError
+        ``--max-offset-deg`` for prismatic joints, or both given.
+    """
+    from zerocal_sym.errors import ZerocalError
+
+    a, b = getattr(args, "max_offset", None), getattr(args, "max_offset_deg", None)
+    if a is not None and b is not None:
+        raise ZerocalError("--max-offset and --max-offset-deg: give one")
+    if b is not None and robot.errors.offset_user_unit != "deg":
+        raise ZerocalError(f"--max-offset-deg: the zero offsets of {robot.mechanism_name} are in mm (prismatic "
+                           "joints): give --max-offset in mm")
+    return a if a is not None else b
 
 
 def trust_kwargs(args, method):
@@ -113,17 +138,18 @@ def offsets_sigma_text(res) -> str:
     """The offsets' 1 sigma and whether it is small against the offsets."""
     import numpy as np
 
-    off = np.abs(np.asarray(res.zero_offsets_deg, float))
-    std = np.asarray(res.std_zero_offsets_deg, float)
+    off = np.abs(np.asarray(res.zero_offsets_user, float))
+    std = np.asarray(res.std_zero_offsets_user, float)
     if not np.all(np.isfinite(std)):
         return "offsets' 1 sigma not available"
     s = ", ".join(f"{x:.3g}" for x in std)
     big = float(np.max(off)) if off.size else 0.0
     small = bool(np.all(std <= 0.1 * np.maximum(off, 1e-12))) or float(np.max(std)) < 0.01
     kind = f" ({res.std_kind})" if getattr(res, "std_kind", None) else ""
-    return (f"offsets' 1 sigma {s} deg{kind}: "
+    u = getattr(res, "offset_unit", "deg")
+    return (f"offsets' 1 sigma {s} {u}{kind}: "
             + ("small against the offsets" if small else
-               f"NOT small against the offsets (largest |offset| {big:.3g} deg); measure more poses"))
+               f"NOT small against the offsets (largest |offset| {big:.3g} {u}); measure more poses"))
 
 
 def _parse_named(items, robot, names, what, parse):
@@ -159,17 +185,20 @@ def maemm_prior_vector(robot, values, option="--maemm-prior"):
 
 
 def compensation_block(robot, res) -> dict:
-    """The ``compensation`` entry of a results JSON: sign convention, joints, offsets and their std (deg)."""
+    """The ``compensation`` entry of a results JSON: sign convention, joints, offsets and their std (the joints'
+    unit: deg or mm)."""
     import numpy as np
 
-    from zerocal_sym.io.compensation import SIGN_CONVENTION
+    from zerocal_sym.io.results import offset_keys, sign_convention
 
-    std = res.std_zero_offsets_deg
+    unit = res.offset_unit
+    off_key, std_key = offset_keys(unit)[2]
+    std = res.std_zero_offsets_user
     return {
-        "sign_convention": SIGN_CONVENTION,
+        "sign_convention": sign_convention(unit),
         "joints": list(robot.mechanism.joint_names),
-        "offset_deg": res.zero_offsets_deg.tolist(),
-        "std_deg": [float(s) if np.isfinite(s) else None for s in std],
+        off_key: res.zero_offsets_user.tolist(),
+        std_key: [float(s) if np.isfinite(s) else None for s in std],
     }
 
 
@@ -198,17 +227,18 @@ def print_estimate(robot, res) -> None:
     """The identified parameters with their std (user units) and the compensation, as text."""
     import numpy as np
 
-    from zerocal_sym.io.compensation import SIGN_CONVENTION
+    from zerocal_sym.io.results import sign_convention
 
     errors = robot.errors
     for n, v in zip(res.params, res.estimate):
         s = res.std(n)
         std = f" ± {errors.to_user_value(n, s):.4g}" if np.isfinite(s) else ""
         print(f"  {n:7s} = {errors.to_user_value(n, v):+.6f}{std} {errors[n].user_unit}")
-    print(f"compensation ({SIGN_CONVENTION}):")
+    print(f"compensation ({sign_convention(res.offset_unit)}):")
     for j, n in enumerate(robot.mechanism.joint_names):
-        s = res.std_zero_offsets_deg[j]
-        print(f"  {n}: offset {res.zero_offsets_deg[j]:+.6f} deg" + (f" (std {s:.4g})" if np.isfinite(s) else ""))
+        s = res.std_zero_offsets_user[j]
+        print(f"  {n}: offset {res.zero_offsets_user[j]:+.6f} {res.offset_unit}"
+              + (f" (std {s:.4g})" if np.isfinite(s) else ""))
 
 
 def run(args):
@@ -226,7 +256,7 @@ def run(args):
     errors = robot.errors
     prior = maemm_prior_vector(robot, args.maemm_prior)
     meas = load_measurements(args.data, robot)  # refuses data of another mechanism or robot (robot_sha256)
-    noise = NoiseModel.named(args.noise)
+    noise = NoiseModel.named(args.noise, robot)
     from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
 
     try:  # the tolerances of the errors left out, checked before any work
@@ -247,11 +277,15 @@ def run(args):
         kw = {}
         if args.rule is not None:
             kw["rule"] = args.rule
+        if args.iterate is not None:
+            if args.iterate < 1:
+                raise ZerocalError(f"--iterate must be >= 1, got {args.iterate}")
+            kw["iterations"] = args.iterate
         res = identify_tsvd(robot, meas, prior=prior, t=args.truncation, noise=None if noise.is_zero else noise,
                             **kw, **trust_kwargs(args, "tsvd"))
     else:
-        if args.truncation is not None or args.rule is not None:
-            raise ZerocalError("--truncation and --rule are for --method tsvd")
+        if args.truncation is not None or args.rule is not None or args.iterate is not None:
+            raise ZerocalError("--truncation, --rule and --iterate are for --method tsvd")
         try:
             names = errors.resolve(args.params)
         except ValueError as exc:
@@ -293,7 +327,7 @@ def run(args):
         return 1
     from zerocal_sym.identify.fitcheck import plausibility
 
-    reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    reasons = plausibility(robot, res, max_offset=max_offset_arg(args, robot), max_maemm_mm=args.max_maemm_mm)
     if reasons:
         out["plausibility"] = reasons
         if args.json:
@@ -320,8 +354,8 @@ def run(args):
     print_estimate(robot, res)
     zo = bias["zero_offsets"]
     print("bias the offsets may carry from the errors left out (first order, their tolerances): worst case "
-          + ", ".join(f"{v:.4g}" for v in zo["worst_case_deg"]) + " deg, RMS "
-          + ", ".join(f"{v:.4g}" for v in zo["rms_deg"]) + " deg (--tolerance NAME=VALUE to change)")
+          + ", ".join(f"{v:.4g}" for v in zo["worst_case_" + zo["unit"]]) + f" {zo['unit']}, RMS "
+          + ", ".join(f"{v:.4g}" for v in zo["rms_" + zo["unit"]]) + f" {zo['unit']} (--tolerance NAME=VALUE to change)")
     info = res.info
     if res.method == "nlls":
         print(f"Ipopt: {info['solver_status']}, {info['iterations']} iterations, cost {info['cost']:.6g}, "

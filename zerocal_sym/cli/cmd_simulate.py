@@ -56,12 +56,13 @@ def add_arguments(p):
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
                    help="noise model (default: paper, Eq. 34 + Eq. 35)")
     poses = p.add_mutually_exclusive_group()
-    poses.add_argument("--scheme", choices=["paper", "ring"], default=None,
+    poses.add_argument("--scheme", choices=["paper", "ring", "corners"], default=None,
                        help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
     poses.add_argument("--poses", metavar="FILE", default=None, type=InputFile("the pose file"),
                        help="pose list instead of a scheme: CSV [pose,]x_mm,y_mm[,z_mm] or design JSON")
     p.add_argument("--n", type=int, default=None,
-                   help="poses per boundary of the scheme, K = 2n (default: 3 paper, 6 ring)")
+                   help="the scheme's size: poses per boundary, K = 2n (default: 3 paper, 6 ring), or the corners, K = n "
+                        "(16, 32 or 64; default 64)")
     p.add_argument("--compensation", nargs="+", type=float, metavar="DEG", default=None,
                    help="compensation already applied, one value per joint, deg (robot frame): "
                         "commanded = IK - compensation")
@@ -97,14 +98,16 @@ def run(args):
     from zerocal_sym.identify.loop import simulate_round
     from zerocal_sym.io.compensation import format_offsets
     from zerocal_sym.io.measurements import write_measurements
+    from zerocal_sym.model import units
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 
     robot = load_robot_arg(args)
     errors = robot.errors
     err, what, meta_truth = true_errors(args, robot)
     joints = robot.mechanism.joint_names
-    comp_deg = np.zeros(robot.m) if args.compensation is None else vector_arg(
-        args.compensation, robot.m, "--compensation", joints, "deg")
+    ju = units.joint_unit(robot)
+    comp_user = np.zeros(robot.m) if args.compensation is None else vector_arg(
+        args.compensation, robot.m, "--compensation", joints, ju)
     if args.poses is not None:
         if args.n is not None:
             from zerocal_sym.errors import ZerocalError
@@ -115,11 +118,11 @@ def run(args):
         poses, n = scheme_poses(robot, args.scheme, args.n)
         pose_what = f"{robot.workspace.scheme_name} scheme, n = {n}"
     rng = np.random.default_rng([args.seed, args.group] if args.group is not None else [args.seed])
-    meas = simulate_round(robot, VirtualPlant(robot, err), poses, np.radians(comp_deg), NoiseModel.named(args.noise),
-                          rng)
+    meas = simulate_round(robot, VirtualPlant(robot, err), poses, units.joints_from_user(robot, comp_user),
+                          NoiseModel.named(args.noise, robot), rng)
     if not np.all(np.isfinite(meas.readings)):
         raise PoseError("the compensated commands leave the robot's assembly (reading is not finite)")
-    offsets_deg = np.degrees(errors.take(err, errors.zero_offsets))
+    offsets_user = units.joints_to_user(robot, errors.take(err, errors.zero_offsets))
     maemm = errors.take(err, errors.measuring)
     meas.meta = {
         "generator": "zerocal simulate",
@@ -129,8 +132,9 @@ def run(args):
         "seed": args.seed,
         "noise": args.noise,
         "poses": pose_what,
-        "compensation_deg": format_offsets(comp_deg) if args.compensation is not None else fmt_values(comp_deg),
-        "true_zero_offsets_deg": fmt_values(offsets_deg),
+        units.joint_key(robot, "compensation"):
+            format_offsets(comp_user) if args.compensation is not None else fmt_values(comp_user),
+        units.joint_key(robot, "true_zero_offsets"): fmt_values(offsets_user),
         "true_maemm_mm": fmt_values(maemm),
         "true_errors": format_named(robot, err).replace(" deg", "").replace(" mm", ""),
     }

@@ -35,7 +35,9 @@ def add_arguments(p):
     p.add_argument("--method", choices=["tsvd", "nlls"], default="tsvd", help="identification method (default tsvd)")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
                    help="noise model for weights and covariance (default paper)")
-    p.add_argument("--mu0", type=float, default=0.1, help="threshold of the compensation accuracy mu, deg (0.1)")
+    p.add_argument("--mu0", type=float, default=None,
+                   help="threshold of the compensation accuracy mu, in the joints' unit (default 0.1 deg, the "
+                        "paper's, for revolute joints; 0.02 mm for prismatic ones)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(),
                    help="write the new result (readable by compensate and verify), atomically")
@@ -48,6 +50,11 @@ def add_arguments(p):
 
 #: commanded angles within this of IK(target) - the result's offsets (deg) are "compensated with that result"
 COMMAND_TOL_DEG = 1e-3
+#: the same in each file unit of the joints (deg: revolute, mm: prismatic)
+COMMAND_TOL = {"deg": COMMAND_TOL_DEG, "mm": 1e-3}
+#: the default threshold mu0 of the compensation accuracy per file unit of the offsets: the paper's 0.1 deg; for
+#: prismatic joints 0.02 mm, about twice the CRLB of a linear Delta's ring scheme
+MU0_DEFAULT = {"deg": 0.1, "mm": 0.02}
 
 
 def check_compensated(robot, meas, offsets_deg, data) -> None:
@@ -56,6 +63,7 @@ def check_compensated(robot, meas, offsets_deg, data) -> None:
 
     from zerocal_sym.errors import DataFileError
     from zerocal_sym.io.compensation import compensated_commands
+    from zerocal_sym.model import units
 
     if meas.target is None:
         return
@@ -64,16 +72,17 @@ def check_compensated(robot, meas, offsets_deg, data) -> None:
     except (ValueError, Exception) as exc:  # noqa: BLE001 - an unreachable target: the commands cannot match
         raise DataFileError(f"the targets cannot be compensated with the result's offsets: {exc}",
                             where=data) from None
-    diff = np.degrees(np.abs(np.asarray(meas.theta_cmd, float) - cmd))
-    bad = np.flatnonzero(np.max(diff, axis=1) > COMMAND_TOL_DEG)
+    u = units.joint_unit(robot)
+    diff = units.joints_to_user(robot, np.abs(np.asarray(meas.theta_cmd, float) - cmd))
+    bad = np.flatnonzero(np.max(diff, axis=1) > COMMAND_TOL[u])
     if bad.size:
         k = int(bad[0])
         j = int(np.argmax(diff[k]))
         joints = robot.mechanism.joint_names
         line = meas.lines[k] if len(meas.lines) > k else None
         raise DataFileError(
-            f"pose {k}: commanded {joints[j]} differs from IK(target) - the result's offset by {diff[k, j]:.4g} deg "
-            f"(> {COMMAND_TOL_DEG:g}): this round was not compensated with this result (zerocal compensate RESULT.json "
+            f"pose {k}: commanded {joints[j]} differs from IK(target) - the result's offset by {diff[k, j]:.4g} {u} "
+            f"(> {COMMAND_TOL[u]:g}): this round was not compensated with this result (zerocal compensate RESULT.json "
             f"--template gives the compensated commands)", where=f"{data}:{line}" if line else data)
 
 
@@ -90,10 +99,11 @@ def run(args):
     from zerocal_sym.io.files import json_safe, staged_directory, to_json, write_json
     from zerocal_sym.io.measurements import load_measurements
     from zerocal_sym.io.results import load_result
+    from zerocal_sym.model import units
     from zerocal_sym.model.noise import NoiseModel
 
-    if not (args.mu0 > 0 and np.isfinite(args.mu0)):
-        raise ZerocalError(f"--mu0 must be a positive number of degrees, got {args.mu0}")
+    if args.mu0 is not None and not (args.mu0 > 0 and np.isfinite(args.mu0)):
+        raise ZerocalError(f"--mu0 must be a positive number (the joints' unit), got {args.mu0}")
     from pathlib import Path
 
     for opt, path in (("--out", args.out), ("--plot", args.plot)):
@@ -103,28 +113,32 @@ def run(args):
     robot = load_robot_arg(args)
     errors = robot.errors
     joints = robot.mechanism.joint_names
+    u = units.joint_unit(robot)
+    mu0 = MU0_DEFAULT[u] if args.mu0 is None else args.mu0
     applied = load_result(args.result, robot=robot)
     check_result_robot(applied, robot, args.result)
+    from zerocal_sym.cli.cmd_identify import max_offset_arg
     from zerocal_sym.identify.fitcheck import plausibility
 
-    reasons = plausibility(robot, applied, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    reasons = plausibility(robot, applied, max_offset=max_offset_arg(args, robot), max_maemm_mm=args.max_maemm_mm)
     if reasons:  # as compensate: not a calibration to verify (and not a prior for the re-identification)
         import sys
 
         print(f"zerocal verify: refused {args.result}: {'; '.join(reasons)}", file=sys.stderr)
         return 1
     meas = load_measurements(args.data, robot)
-    declared = parse_offsets(meas.meta.get("compensation_deg"), robot.m)
-    if declared is not None and np.max(np.abs(declared - applied.zero_offsets_deg)) > 1e-4:
-        line = meas.meta_lines.get("compensation_deg")
+    comp_key = units.joint_key(robot, "compensation")
+    declared = parse_offsets(meas.meta.get(comp_key), robot.m)
+    if declared is not None and np.max(np.abs(declared - applied.zero_offsets_user)) > 1e-4:
+        line = meas.meta_lines.get(comp_key)
         fmt = lambda v: "(" + ", ".join(f"{x:g}" for x in v) + ")"  # noqa: E731
         raise DataFileError(
-            f"the data were measured with compensation {fmt(declared)} deg, not with the "
-            f"result's offsets {fmt(applied.zero_offsets_deg)} deg",
+            f"the data were measured with compensation {fmt(declared)} {u}, not with the "
+            f"result's offsets {fmt(applied.zero_offsets_user)} {u}",
             where=f"{args.data}:{line}" if line else args.data)
-    check_compensated(robot, meas, applied.zero_offsets_deg, args.data)
-    noise = NoiseModel.named(args.noise)
-    prior = errors.put(errors.zeros(), errors.zero_offsets, np.radians(applied.zero_offsets_deg))
+    check_compensated(robot, meas, applied.zero_offsets_user, args.data)
+    noise = NoiseModel.named(args.noise, robot)
+    prior = errors.put(errors.zeros(), errors.zero_offsets, applied.zero_offsets)
     if np.all(np.isfinite(applied.maemm_mm)):
         prior = errors.put(prior, errors.measuring, applied.maemm_mm)
     if args.method == "tsvd":
@@ -146,26 +160,26 @@ def run(args):
         if diagnosis(res):
             print(diagnosis(res), file=sys.stderr)
         return 1
-    reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    reasons = plausibility(robot, res, max_offset=max_offset_arg(args, robot), max_maemm_mm=args.max_maemm_mm)
     if reasons:
         import sys
 
         print(f"zerocal verify: re-identification rejected: {'; '.join(reasons)}; no result written", file=sys.stderr)
         return 1
-    new = res.zero_offsets_deg
-    remaining = new - applied.zero_offsets_deg
+    new = res.zero_offsets_user
+    remaining = new - applied.zero_offsets_user
     mu = float(np.sqrt(np.mean(remaining**2)))
-    std = res.std_zero_offsets_deg
-    passed = mu < args.mu0
+    std = res.std_zero_offsets_user
+    passed = mu < mu0
     report = {
         "passed": bool(passed),
-        "mu_deg": mu,
-        "mu0_deg": args.mu0,
+        f"mu_{u}": mu,
+        f"mu0_{u}": mu0,
         "joints": list(joints),
-        "applied_offsets_deg": applied.zero_offsets_deg.tolist(),
-        "new_offsets_deg": new.tolist(),
-        "remaining_offsets_deg": remaining.tolist(),
-        "std_new_offsets_deg": [float(s) if np.isfinite(s) else None for s in std],
+        f"applied_offsets_{u}": applied.zero_offsets_user.tolist(),
+        f"new_offsets_{u}": new.tolist(),
+        f"remaining_offsets_{u}": remaining.tolist(),
+        f"std_new_offsets_{u}": [float(s) if np.isfinite(s) else None for s in std],
         "method": res.method,
         "data": str(args.data),
         "applied_result": str(args.result),
@@ -193,11 +207,11 @@ def run(args):
         vec = lambda v: ", ".join(f"{x:+.4f}" for x in v)  # noqa: E731
         print(f"{args.data}: re-identified ({res.method}) with the compensation of {args.result} applied "
               f"(joints {', '.join(joints)})")
-        print(f"  applied   offsets: {vec(applied.zero_offsets_deg)} deg")
-        print(f"  new       offsets: {vec(new)} deg (std {', '.join(f'{s:.3g}' for s in std)})")
-        print(f"  remaining offsets: {vec(remaining)} deg")
+        print(f"  applied   offsets: {vec(applied.zero_offsets_user)} {u}")
+        print(f"  new       offsets: {vec(new)} {u} (std {', '.join(f'{s:.3g}' for s in std)})")
+        print(f"  remaining offsets: {vec(remaining)} {u}")
         verdict = "PASS" if passed else "FAIL: apply the new result and measure again"
-        print(f"  mu = {mu:.4f} deg {'<' if passed else '>='} mu0 = {args.mu0:g} deg: {verdict}")
+        print(f"  mu = {mu:.4f} {u} {'<' if passed else '>='} mu0 = {mu0:g} {u}: {verdict}")
         if args.out:
             print(f"wrote {args.out}")
     return 0 if passed else 1

@@ -241,7 +241,7 @@ def tolerance_bias(robot, theta_cmd, tolerances=None, params="paper", noise: Noi
     dict
         ``params``, ``units`` (user units per parameter), ``worst_case`` and
         ``rms`` (user units, per parameter), ``zero_offsets`` {``names``,
-        ``worst_case_deg``, ``rms_deg``}, ``tolerances`` (user units by
+        ``unit``, ``worst_case_deg``, ``rms_deg``} (``_mm`` for prismatic joints), ``tolerances`` (user units by
         name), ``sensitivity`` (per omitted error, user units per user unit:
         rows the parameters), ``model``.
     """
@@ -260,8 +260,9 @@ def tolerance_bias(robot, theta_cmd, tolerances=None, params="paper", noise: Noi
         "units": {n: errors[n].user_unit for n in names},
         "worst_case": (worst * to_user).tolist(),
         "rms": (rms * to_user).tolist(),
-        "zero_offsets": {"names": [names[i] for i in off], "worst_case_deg": (worst * to_user)[off].tolist(),
-                         "rms_deg": (rms * to_user)[off].tolist()},
+        "zero_offsets": {"names": [names[i] for i in off], "unit": errors.offset_user_unit,
+                         f"worst_case_{errors.offset_user_unit}": (worst * to_user)[off].tolist(),
+                         f"rms_{errors.offset_user_unit}": (rms * to_user)[off].tolist()},
         "tolerances": {n: errors.to_user_value(n, v) for n, v in zip(om, t)},
         "tolerance_units": {n: errors[n].user_unit for n in om},
         "sensitivity": {"rows": list(names), "columns": list(om),

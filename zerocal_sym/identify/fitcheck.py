@@ -79,6 +79,8 @@ from zerocal_sym.identify.fitstats import (DEFAULT_ALPHA, LEVERAGE_TOL, RANK_RTO
 
 #: a zero offset beyond this (deg) is not a zero offset but a wrong joint zero / sign / robot file
 DEFAULT_MAX_OFFSET_DEG = 10.0
+#: the same per file unit of the zero offsets (deg: revolute joints, mm: prismatic ones)
+DEFAULT_MAX_OFFSET = {"deg": DEFAULT_MAX_OFFSET_DEG, "mm": 10.0}
 #: a MAEMM (norm, mm) beyond this is not an assembly error but a wrong measuring-mechanism geometry
 DEFAULT_MAX_MAEMM_MM = 50.0
 #: a reading whose robust weight ends below this is an outlier: named, and left out of the fit check
@@ -247,8 +249,8 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
             "summary": summary, "threshold": float(threshold), "dof": int(lin.dof), "method": method}
 
 
-def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
-                 max_maemm_mm: float = DEFAULT_MAX_MAEMM_MM) -> list:
+def plausibility(robot, result, max_offset: float | None = None,
+                 max_maemm_mm: float = DEFAULT_MAX_MAEMM_MM, max_offset_deg: float | None = None) -> list:
     """Reasons not to use ``result`` as a calibration (empty list: plausible).
 
     ``result``: an :class:`~zerocal_sym.identify.result.IdentificationResult`
@@ -259,9 +261,12 @@ def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
     * not a calibration: ``success`` is False (not converged, not
       identifiable, the fit rejected) -- a result accepted despite misfit is
       one;
-    * a zero offset beyond ``max_offset_deg`` (default 10 deg: far beyond a
-      homing error; the first-order model and TSVD's linearisation fail
-      there, and it usually is a wrong joint zero, sign or robot file);
+    * a zero offset beyond ``max_offset`` (in the joints' unit; default 10
+      deg for revolute joints: far beyond a homing error; the first-order
+      model and TSVD's linearisation fail there, and it usually is a wrong
+      joint zero, sign or robot file; 10 mm for prismatic joints: beyond an
+      endstop's repeatability, a wrong robot file); ``max_offset_deg``, its
+      former name, for revolute joints;
     * a MAEMM (norm of the measuring mechanism's assembly error) beyond
       ``max_maemm_mm`` (default 50 mm, ~7 % of the planar robot's measuring
       length: not an assembly error but a wrong ``c``/``d`` in the robot
@@ -273,15 +278,18 @@ def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
     if not result.success:
         reasons.append(f"the identification is not a calibration: {result.status}")
     errors = robot.errors
-    off = np.asarray(result.zero_offsets_deg, float)
+    unit = errors.offset_user_unit
+    limit = max_offset if max_offset is not None else max_offset_deg
+    limit = DEFAULT_MAX_OFFSET[unit] if limit is None else limit
+    off = np.asarray(result.zero_offsets_user, float)
     for n, v in zip(errors.zero_offsets, off):
         if not np.isfinite(v):
             reasons.append(f"zero offset {n} is not a finite number")
-        elif abs(v) > max_offset_deg:
-            reasons.append(f"zero offset {n} = {v:+.4g} deg is beyond the plausible {max_offset_deg:g} deg "
+        elif abs(v) > limit:
+            reasons.append(f"zero offset {n} = {v:+.4g} {unit} is beyond the plausible {limit:g} {unit} "
                            "(a wrong joint zero, sign convention or robot file?)")
     params = getattr(result, "params", None)  # None: a results file (io.results.ResultFile)
-    std = np.asarray(result.std_zero_offsets_deg, float)
+    std = np.asarray(result.std_zero_offsets_user, float)
     for n, s in zip(errors.zero_offsets, std):
         if params is not None and n in params and not np.isfinite(s):
             reasons.append(f"the standard deviation of zero offset {n} is not finite (not identifiable)")

@@ -24,6 +24,7 @@ from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify.linear import condition_number, identification_matrix
 from zerocal_sym.identify.tsvd import identify_tsvd
 from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model import units
 from zerocal_sym.model.measurements import Measurements
 
 
@@ -93,13 +94,15 @@ class IterationRecord:
     ----------
     result : IdentificationResult
     compensation_deg : ndarray, shape (m,)
-        Compensation value (sum of increments) after this identification, our frame.
+        Compensation value (sum of increments) after this identification, our frame, in the joints' file
+        unit: deg for revolute joints, mm for prismatic ones (so are the increment and mu; the names keep the
+        revolute spelling).
     increment_deg : ndarray, shape (m,)
     mu_deg : float or None
         Compensation accuracy (None at the first identification).
     kappa : float
         Condition number of G of this identification (Eq. 28's G when the identifier does not report it).
-    maemm_mm : ndarray, shape (n,)
+    maemm_mm : ndarray, shape (u,)
     """
 
     result: object
@@ -304,7 +307,11 @@ def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_
     prior = errors.zeros()
     if maemm_prior is not None:
         prior = errors.put(prior, meas_names, np.asarray(maemm_prior, float))
-    out = LoopResult(compensation_deg=np.zeros(robot.m), maemm_mm=np.zeros(robot.n))
+    out = LoopResult(compensation_deg=np.zeros(robot.m), maemm_mm=np.zeros(len(meas_names)))
+
+    def user(v):  # the joints' file unit: deg (revolute), mm (prismatic); the attribute names say deg
+        return units.to_user(v, errors.offset_unit)
+
     comp = np.zeros(robot.m)
     theta = kin.ik(robot, poses) if theta is None else theta
     i_off, i_meas = [errors.index(n) for n in offs], [errors.index(n) for n in meas_names]  # take / put
@@ -321,17 +328,17 @@ def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_
         new = np.array([res.value(n) for n in offs])
         maemm = np.array([res.value(n, v) for n, v in zip(meas_names, prior[i_meas])])
         inc = new - comp
-        mu = None if j == 1 else float(np.degrees(np.sqrt(np.mean(inc**2))))
+        mu = None if j == 1 else float(user(np.sqrt(np.mean(inc**2))))
         kap = float(res.info.get("kappa", np.nan)) if isinstance(res.info, dict) else float("nan")
         if kappa and not np.isfinite(kap):  # the paper's G (Eq. 28) of this round
             P = kin.fk(robot, meas.theta_cmd + errors.take(prior, offs))
             kap = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
-        out.history.append(IterationRecord(res, np.degrees(new), np.degrees(inc), mu, kap, maemm.copy()))
+        out.history.append(IterationRecord(res, user(new), user(inc), mu, kap, maemm.copy()))
         comp = new
         prior = prior.copy()
         prior[i_off], prior[i_meas] = new, maemm
         if not out.converged:
-            out.compensation_deg, out.maemm_mm, out.iterations = np.degrees(new), maemm.copy(), j
+            out.compensation_deg, out.maemm_mm, out.iterations = user(new), maemm.copy(), j
             if mu is not None and mu < mu0_deg:
                 out.converged = True
                 if not run_all:

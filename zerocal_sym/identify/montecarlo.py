@@ -40,6 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from zerocal_sym.model import units
+
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
@@ -92,7 +94,7 @@ def _record_loop(record, m, loop, n_id, t_id, methods, paper4):
     if loop is None:
         record(m, None, t_id, n_id)
         return
-    est = np.concatenate([np.radians(loop.compensation_deg), loop.maemm_mm])
+    est = np.concatenate([units.from_user(loop.compensation_deg, robot.errors.offset_unit), loop.maemm_mm])
     record(m, est, t_id, n_id, loop.converged)
 
 

@@ -53,8 +53,43 @@ def _validate(meas, robot, p):
     return th, rd
 
 
+#: an iterated TSVD stops when its increment is below this (rad, mm)
+ITERATE_TOL = 1e-10
+
+
 def identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None, rtol=DEFAULT_RTOL,
-                  fit_alpha: float | None = None, accept_misfit: bool = False, diagnostics: bool = True):
+                  fit_alpha: float | None = None, accept_misfit: bool = False, diagnostics: bool = True,
+                  iterations: int = 1):
+    """Identify zero offsets and MAEMM from one round of measurements by TSVD (see :func:`_identify_tsvd`).
+
+    ``iterations`` > 1: the TSVD iterated -- relinearised at its estimate (the estimate as the next prior) until
+    the largest increment is below :data:`ITERATE_TOL` or ``iterations`` steps were taken; the result is the
+    last step's, with ``info["tsvd_iterations"]`` and ``info["tsvd_converged"]``.  One step (the default) is
+    the paper's: its linearisation at zero errors leaves a bias the iteration removes.
+    """
+    kw = dict(t=t, rule=rule, noise=noise, rtol=rtol, fit_alpha=fit_alpha, accept_misfit=accept_misfit,
+              diagnostics=diagnostics)
+    if iterations < 1:
+        raise ValueError(f"iterations must be >= 1, got {iterations}")
+    errors = robot.errors
+    res = _identify_tsvd(robot, meas, prior, **kw)
+    if iterations == 1:
+        return res
+    for j in range(2, iterations + 1):
+        step = res.info["increment"]
+        if not np.all(np.isfinite(step)) or np.max(np.abs(step)) < ITERATE_TOL:
+            break
+        base = errors.zeros() if prior is None else np.asarray(prior, float)
+        res = _identify_tsvd(robot, meas, errors.put(base, res.params, res.estimate), **kw)
+    else:
+        j = iterations + 1
+    res.info["tsvd_iterations"] = j - 1
+    res.info["tsvd_converged"] = bool(np.max(np.abs(res.info["increment"])) < ITERATE_TOL)
+    return res
+
+
+def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=None, rtol=DEFAULT_RTOL,
+                   fit_alpha: float | None = None, accept_misfit: bool = False, diagnostics: bool = True):
     """Identify zero offsets and MAEMM from one round of measurements by TSVD.
 
     The model is linearised at the prior: the nominal poses are

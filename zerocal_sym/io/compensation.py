@@ -20,7 +20,8 @@ import re
 import numpy as np
 
 from zerocal_sym.io.csvtext import MECHANISM_KEY, _format_meta, get_mechanism_of, mechanism_for_shape
-from zerocal_sym.io.results import SIGN_CONVENTION, ResultFile
+from zerocal_sym.io.results import SIGN_CONVENTION, ResultFile, sign_convention  # noqa: F401 (SIGN_CONVENTION)
+from zerocal_sym.model import units
 
 COMPENSATION_LINE = "# zerocal compensation v1"
 
@@ -58,7 +59,7 @@ def parse_offsets(text, m: int | None = None) -> np.ndarray | None:
     return out
 
 
-def compensated_commands(robot, P, offsets_deg) -> tuple[np.ndarray, np.ndarray]:
+def compensated_commands(robot, P, offsets_user) -> tuple[np.ndarray, np.ndarray]:
     """Nominal and compensated joint commands for target positions.
 
     Parameters
@@ -66,15 +67,15 @@ def compensated_commands(robot, P, offsets_deg) -> tuple[np.ndarray, np.ndarray]
     robot : Robot
     P : ndarray, shape (K, n)
         Target positions, mm.
-    offsets_deg : array_like, shape (m,)
-        Identified zero offsets, deg, joint order.
+    offsets_user : array_like, shape (m,)
+        Identified zero offsets in the joints' file unit (deg, mm), joint order.
 
     Returns
     -------
     theta_nominal : ndarray, shape (K, m)
-        ``IK(P)``, rad.
+        ``IK(P)``, internal units (rad, mm).
     theta_cmd : ndarray, shape (K, m)
-        ``IK(P) - offset``, rad (what to command).
+        ``IK(P) - offset``, internal units (what to command).
 
     Raises
     ------
@@ -85,9 +86,9 @@ def compensated_commands(robot, P, offsets_deg) -> tuple[np.ndarray, np.ndarray]
     """
     from zerocal_sym.model import kinematics as kin
 
-    off = _offsets(offsets_deg, robot.m)
+    off = _offsets(offsets_user, robot.m)
     nominal = kin.ik(robot, np.atleast_2d(np.asarray(P, float)))
-    return nominal, nominal - np.radians(off)
+    return nominal, nominal - units.joints_from_user(robot, off)
 
 
 def _mechanism(mechanism, m, n=None, declared=None):
@@ -114,30 +115,35 @@ def format_compensation(result: ResultFile, meta: dict | None = None, mechanism=
         CSV ``joint,offset_deg,std_deg`` with comment lines stating the sign
         convention (and the mechanism).
     """
-    m = len(result.zero_offsets_deg)
+    m = len(result.zero_offsets_user)
     mech = _mechanism(mechanism, m, declared=result.mechanism)
     joints = list(mech.joint_names) if mech is not None else [f"theta{j + 1}" for j in range(m)]
     if len(joints) != m:
         raise ValueError(f"{m} zero offsets for the {len(joints)} joints of mechanism {mech.name}")
+    u = result.offset_unit
     buf = io.StringIO()
     buf.write(COMPENSATION_LINE + "\n")
-    buf.write(_format_meta({"sign": SIGN_CONVENTION, **({MECHANISM_KEY: mech.name} if mech else {}),
+    buf.write(_format_meta({"sign": sign_convention(u), **({MECHANISM_KEY: mech.name} if mech else {}),
                            "method": result.method, "status": result.status,
                            **({"robot_sha256": result.robot_sha256} if result.robot_sha256 else {}),
                            **(meta or {})}))
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["joint", "offset_deg", "std_deg"])
+    w.writerow(["joint", f"offset_{u}", f"std_{u}"])
     for j, name in enumerate(joints):
-        s = result.std_zero_offsets_deg[j]
-        w.writerow([name, repr(float(result.zero_offsets_deg[j])), "" if not np.isfinite(s) else repr(float(s))])
+        s = result.std_zero_offsets_user[j]
+        w.writerow([name, repr(float(result.zero_offsets_user[j])), "" if not np.isfinite(s) else repr(float(s))])
     return buf.getvalue()
 
 
 def command_columns(mechanism) -> list:
-    """``pose, x_mm, y_mm[, z_mm], theta1_nominal_deg, ..., theta1_cmd_deg, ...`` of ``mechanism``."""
+    """``pose, x_mm, y_mm[, z_mm], theta1_nominal_deg, ..., theta1_cmd_deg, ...`` of ``mechanism`` (the units of
+    its pose coordinates and joints)."""
+    from zerocal_sym.io.csvtext import pose_columns
+
     mech = get_mechanism_of(mechanism)
-    return (["pose"] + [p + "_mm" for p in mech.pose_names] + [j + "_nominal_deg" for j in mech.joint_names]
-            + [j + "_cmd_deg" for j in mech.joint_names])
+    ju = mech.joint_user_unit
+    return (["pose"] + list(pose_columns(mech)) + [f"{j}_nominal_{ju}" for j in mech.joint_names]
+            + [f"{j}_cmd_{ju}" for j in mech.joint_names])
 
 
 def format_commands(P, theta_nominal, theta_cmd, offsets_deg, meta: dict | None = None, mechanism=None) -> str:
@@ -167,8 +173,8 @@ def format_commands(P, theta_nominal, theta_cmd, offsets_deg, meta: dict | None 
         Sizes that do not fit each other or the mechanism.
     """
     P = np.atleast_2d(np.asarray(P, float))
-    nom = np.degrees(np.atleast_2d(np.asarray(theta_nominal, float)))
-    cmd = np.degrees(np.atleast_2d(np.asarray(theta_cmd, float)))
+    nom = np.atleast_2d(np.asarray(theta_nominal, float))
+    cmd = np.atleast_2d(np.asarray(theta_cmd, float))
     K, n = P.shape
     m = nom.shape[1]
     if nom.shape != (K, m) or cmd.shape != (K, m):
@@ -179,9 +185,11 @@ def format_commands(P, theta_nominal, theta_cmd, offsets_deg, meta: dict | None 
         raise ValueError(f"no single registered mechanism has {m} joints and {n} pose coordinates: pass mechanism=")
     if (mech.m, mech.n) != (m, n):
         raise ValueError(f"mechanism {mech.name} has {mech.m} joints and {mech.n} pose coordinates, got {m} and {n}")
+    u = mech.joint_user_unit
+    nom, cmd, P = units.joints_to_user(mech, nom), units.joints_to_user(mech, cmd), units.pose_to_user(mech, P)
     buf = io.StringIO()
     buf.write(COMPENSATION_LINE + "\n")
-    buf.write(_format_meta({"sign": SIGN_CONVENTION, MECHANISM_KEY: mech.name, "offset_deg": format_offsets(off),
+    buf.write(_format_meta({"sign": sign_convention(u), MECHANISM_KEY: mech.name, f"offset_{u}": format_offsets(off),
                            **(meta or {})}))
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(command_columns(mech))

@@ -3,8 +3,10 @@
 Results JSON
 ------------
 :func:`load_result` reads what ``zerocal identify --json`` writes, for any
-mechanism: ``zero_offsets_deg`` (joint order, m values), ``std_zero_offsets_deg``
-(m values or nulls), ``maemm_mm`` (pose-coordinate order, n values), the
+mechanism: ``zero_offsets_deg`` (revolute joints; ``zero_offsets_mm`` for
+prismatic ones: every offset key carries the joints' unit; joint order, m
+values), ``std_zero_offsets_deg`` (m values or nulls), ``maemm_mm`` (the
+measuring errors' order, u values), the
 parameters by name (``estimate``, ``std``, ``units``) and, when present, the
 ``mechanism``.  The compensation table made from it is
 :mod:`zerocal_sym.io.compensation`.
@@ -33,14 +35,27 @@ import numpy as np
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import _json_line, _load_json, _read_text, get_mechanism_of, mechanism_for_shape
 
-#: the sign convention of every file that carries offsets (a results file's ``compensation.sign_convention``)
-SIGN_CONVENTION = "theta_cmd = IK(P) - offset_deg (actual joint angle = commanded + offset)"
-#: the unit of the zero offsets at the file edge: every key that names them is made from it here
+#: the unit of the zero offsets at the file edge of a revolute mechanism (a prismatic one's: mm); every key that
+#: names them is made from the unit here (:func:`offset_keys`)
 OFFSET_UNIT = "deg"
-OFFSETS_KEY = f"zero_offsets_{OFFSET_UNIT}"
-STD_OFFSETS_KEY = f"std_{OFFSETS_KEY}"
-#: the offsets and their standard deviations in the ``compensation`` block
-COMPENSATION_KEYS = (f"offset_{OFFSET_UNIT}", f"std_{OFFSET_UNIT}")
+
+
+def sign_convention(unit: str = OFFSET_UNIT) -> str:
+    """The sign convention of every file that carries offsets (a results file's ``compensation.sign_convention``)."""
+    what = "angle" if unit == "deg" else "position"
+    return f"theta_cmd = IK(P) - offset_{unit} (actual joint {what} = commanded + offset)"
+
+
+#: the revolute mechanisms' sign convention (the files written before prismatic joints)
+SIGN_CONVENTION = sign_convention()
+
+
+def offset_keys(unit: str = OFFSET_UNIT) -> tuple:
+    """``(zero_offsets_<u>, std_zero_offsets_<u>, (offset_<u>, std_<u>))``: the keys of the offsets in the unit."""
+    return f"zero_offsets_{unit}", f"std_zero_offsets_{unit}", (f"offset_{unit}", f"std_{unit}")
+
+
+OFFSETS_KEY, STD_OFFSETS_KEY, COMPENSATION_KEYS = offset_keys()
 MAEMM_KEY = "maemm_mm"
 #: two copies of one value (a key and ``estimate``, ``compensation``) agree within this (relative and absolute)
 SAME_VALUE_TOL = 1e-9
@@ -54,9 +69,9 @@ class ResultFile:
 
     Attributes
     ----------
-    zero_offsets_deg : ndarray, shape (m,)
-        Joint order.
-    std_zero_offsets_deg : ndarray, shape (m,)
+    zero_offsets_user : ndarray, shape (m,)
+        Joint order, in the file's unit (:attr:`offset_unit`: deg for revolute joints, mm for prismatic ones).
+    std_zero_offsets_user : ndarray, shape (m,)
         NaN where unknown.
     maemm_mm : ndarray, shape (n,)
         Pose-coordinate order; NaN where unknown.
@@ -76,8 +91,8 @@ class ResultFile:
     units : dict of str -> str
     """
 
-    zero_offsets_deg: np.ndarray
-    std_zero_offsets_deg: np.ndarray
+    zero_offsets_user: np.ndarray
+    std_zero_offsets_user: np.ndarray
     maemm_mm: np.ndarray
     method: str
     status: str
@@ -89,10 +104,18 @@ class ResultFile:
     estimate: dict = field(default_factory=dict)
     std: dict = field(default_factory=dict)
     units: dict = field(default_factory=dict)
+    offset_unit: str = OFFSET_UNIT
+
+    @property
+    def zero_offsets(self) -> np.ndarray:
+        """The zero offsets in internal units (rad, mm), shape (m,)."""
+        from zerocal_sym.model.units import from_user
+
+        return from_user(self.zero_offsets_user, "rad" if self.offset_unit == "deg" else "mm")
 
     @property
     def m(self) -> int:
-        return len(self.zero_offsets_deg)
+        return len(self.zero_offsets_user)
 
     @property
     def n(self) -> int:
@@ -174,13 +197,14 @@ def _find_sha(obj, text, src):
 
 def _find_mechanism(obj, text, src):
     """The ``mechanism`` key (and ``robot.mechanism``, which must agree), checked; None without."""
-    from zerocal_sym.model.mechanism import REGISTRY
+    from zerocal_sym.model.mechanism import known_mechanisms
 
+    known = known_mechanisms()
     named = [(k, v) for k, v in (("mechanism", obj.get("mechanism")),
                                  ("robot.mechanism", _robot_block(obj, text, src).get("mechanism"))) if v is not None]
     for k, v in named:
-        if not isinstance(v, str) or v not in REGISTRY:
-            raise DataFileError(f"key '{k}': unknown mechanism {json.dumps(v)[:60]} (known: {', '.join(REGISTRY)})",
+        if not isinstance(v, str) or v not in known:
+            raise DataFileError(f"key '{k}': unknown mechanism {json.dumps(v)[:60]} (known: {', '.join(known)})",
                                 where=_where(text, "mechanism", src))
     if len(named) == 2 and named[0][1] != named[1][1]:
         raise DataFileError(f"key 'mechanism' is {named[0][1]}, 'robot.mechanism' is {named[1][1]}: one result is of "
@@ -250,7 +274,7 @@ def _check_names(obj, key, want, text, src) -> None:
                             where=_where(text, key, src))
 
 
-def _compensation(obj, names, off, std, joints, text, src) -> np.ndarray:
+def _compensation(obj, names, off, std, joints, text, src, unit=OFFSET_UNIT) -> np.ndarray:
     """The ``compensation`` block, if any: the same offsets, std, joints and sign convention as the rest.
 
     Returns ``std`` with the block's ``std_deg`` merged in (:func:`_merge`).
@@ -260,20 +284,20 @@ def _compensation(obj, names, off, std, joints, text, src) -> np.ndarray:
         return std
     where = _where(text, "compensation", src)
     if not isinstance(c, dict):
-        raise DataFileError("key 'compensation' must be an object {sign_convention, joints, offset_deg, std_deg}",
-                            where=where)
+        raise DataFileError(f"key 'compensation' must be an object {{sign_convention, joints, offset_{unit}, "
+                            f"std_{unit}}}", where=where)
     sign = c.get("sign_convention")
-    if sign is not None and sign != SIGN_CONVENTION:
+    if sign is not None and sign != sign_convention(unit):
         raise DataFileError(f"key 'compensation': sign_convention {json.dumps(sign)[:80]} is not zerocal's "
-                            f"({SIGN_CONVENTION!r}): the offsets would be applied with the wrong sign",
+                            f"({sign_convention(unit)!r}): the offsets would be applied with the wrong sign",
                             where=_where(text, "sign_convention", src))
     if joints is not None:
         _check_names(c, "joints", joints, text, src)
-    off_key, std_key = COMPENSATION_KEYS
+    offsets_key, std_offsets_key, (off_key, std_key) = offset_keys(unit)
     comp_off = _vector(c, off_key, names, text, src, required=False)
     comp_std = _vector(c, std_key, names, text, src, required=False, std=True)
-    _merge(off_key, dict(zip(names, comp_off)), OFFSETS_KEY, names, off, text, src)
-    return _merge(std_key, dict(zip(names, comp_std)), STD_OFFSETS_KEY, names, std, text, src)
+    _merge(off_key, dict(zip(names, comp_off)), offsets_key, names, off, text, src)
+    return _merge(std_key, dict(zip(names, comp_std)), std_offsets_key, names, std, text, src)
 
 
 def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
@@ -317,12 +341,14 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     elif declared is not None:
         mech = get_mechanism_of(declared)
     else:
-        off = obj.get("zero_offsets_deg")
+        off = obj.get(OFFSETS_KEY)
         mech = mechanism_for_shape(m=len(off)) if isinstance(off, list) else None
     shape_of = mech or get_mechanism_of(None)  # the sizes expected when the mechanism is unknown
     names, measuring = shape_of.errors.zero_offsets, shape_of.errors.measuring
-    off = _vector(obj, OFFSETS_KEY, names, text, src)
-    std = _vector(obj, STD_OFFSETS_KEY, names, text, src, required=False, std=True)
+    unit = shape_of.errors.offset_user_unit
+    offsets_key, std_offsets_key, _ = offset_keys(unit)
+    off = _vector(obj, offsets_key, names, text, src)
+    std = _vector(obj, std_offsets_key, names, text, src, required=False, std=True)
     maemm = _vector(obj, MAEMM_KEY, measuring, text, src, required=False)
     success = obj.get("success", True)
     for key in ("status", "method"):
@@ -338,12 +364,13 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     estimate = _by_name(obj, "estimate", mech, text, src, "value")
     stds = _by_name(obj, "std", mech, text, src, "std")
     units = _by_name(obj, "units", mech, text, src, "unit")
-    off = _merge("estimate", estimate, OFFSETS_KEY, names, off, text, src)
-    std = _merge("std", stds, STD_OFFSETS_KEY, names, std, text, src)
+    off = _merge("estimate", estimate, offsets_key, names, off, text, src)
+    std = _merge("std", stds, std_offsets_key, names, std, text, src)
     maemm = _merge("estimate", estimate, MAEMM_KEY, measuring, maemm, text, src)
     if mech is not None:
         _check_names(obj, "joint_names", mech.joint_names, text, src)
         _check_names(obj, "pose_names", mech.pose_names, text, src)
-    std = _compensation(obj, names, off, std, None if mech is None else mech.joint_names, text, src)
+    std = _compensation(obj, names, off, std, None if mech is None else mech.joint_names, text, src, unit)
     return ResultFile(off, std, maemm, obj.get("method") or "?", status, success, _find_sha(obj, text, src), obj, src,
-                      mechanism=None if mech is None else mech.name, estimate=estimate, std=stds, units=units)
+                      mechanism=None if mech is None else mech.name, estimate=estimate, std=stds, units=units,
+                      offset_unit=unit)

@@ -59,6 +59,10 @@ class _Shape:
         """The scheme parameters n whose scheme has at most K poses."""
         return list(range(2, K // 2 + 1))
 
+    def min_scheme_n(self, p: int) -> int:
+        """The smallest scheme parameter n whose K - 1 changes are at least p."""
+        return max(2, -(-(p + 1) // 2))
+
 
 @dataclass(frozen=True)
 class Rectangle(_Shape):
@@ -325,6 +329,13 @@ class Box(_Shape):
 
     def scheme_sizes(self, K: int) -> list:
         return [k for k in sorted(BOX_FRACTIONS) if k <= K]
+
+    def min_scheme_n(self, p: int) -> int:
+        fit = [k for k in sorted(BOX_FRACTIONS) if k - 1 >= p]
+        if not fit:
+            raise PoseError(f"the corner scheme's {max(BOX_FRACTIONS)} corners give too few changes for {p} "
+                            "parameters")
+        return fit[0]
 
     def boundary_scheme(self, n: int) -> np.ndarray:
         """The corner scheme: the 64 corners in binary order, or the regular fraction of 32 or 16.

@@ -388,6 +388,6 @@ def identify_plots(out_dir, result, meas, robot, err_true=None) -> dict:
     out = {"residuals.png": plot_residuals(result, meas, out_dir / "residuals.png", robot)}
     if err_true is not None:
         out["boundary_errors.png"] = plot_boundary_errors(
-            robot, err_true, result.zero_offsets_deg, out_dir / "boundary_errors.png",
+            robot, err_true, result.zero_offsets_user, out_dir / "boundary_errors.png",
             title=f"Boundary position error (simulated truth), {result.method} compensation")
     return out
