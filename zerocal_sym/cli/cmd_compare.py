@@ -119,7 +119,7 @@ def run(args):
                                           poses=f"the {len(poses)} poses{of}")
         if problem:
             raise ZerocalError(f"--params {args.params}: {problem}")
-    noise = NoiseModel.named(args.noise)
+    noise = NoiseModel.named(args.noise, robot)
     ex = _parallel.execution(args)  # checked (and a scheduler reached) before any work
     common = dict(trials=args.trials, poses=poses, params=params, noise=noise, seed=args.seed, methods=methods,
                   mu0_deg=args.mu0, max_iter=args.max_iter, **ex)

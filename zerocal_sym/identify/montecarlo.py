@@ -80,7 +80,7 @@ def _continued(ss, state):
     return np.random.Generator(bg)
 
 
-def _record_loop(record, m, loop, n_id, t_id, methods, paper4):
+def _record_loop(record, m, loop, n_id, t_id, methods, paper4, errors):
     """Record loop method ``m`` (a LoopResult, None if it failed) and, for ``tsvd-loop``, its first identification
     as ``tsvd``; ``n_id`` identifications took ``t_id`` seconds."""
     if m == "tsvd-loop" and "tsvd" in methods:
@@ -94,8 +94,10 @@ def _record_loop(record, m, loop, n_id, t_id, methods, paper4):
     if loop is None:
         record(m, None, t_id, n_id)
         return
-    est = np.concatenate([units.from_user(loop.compensation_deg, robot.errors.offset_unit), loop.maemm_mm])
-    record(m, est, t_id, n_id, loop.converged)
+    full = errors.put(errors.put(errors.zeros(), errors.zero_offsets,
+                                 units.from_user(loop.compensation_deg, errors.offset_unit)),
+                      errors.measuring, loop.maemm_mm)
+    record(m, errors.take(full, paper4), t_id, n_id, loop.converged)
 
 
 def _identity_report(values, which):
@@ -154,7 +156,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
     errors = robot.errors
     offs = errors.zero_offsets
     paper4 = errors.resolve("default")
-    m_, n_ = len(offs), len(errors.measuring)
+    m_, n_ = len(offs), len(paper4) - len(offs)  # the identified measuring errors: those of the default set
     report = task.report or _identity_report
     plant = VirtualPlant(robot, task.err)
     true4 = errors.take(task.err, paper4)
@@ -171,7 +173,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
             return
         r.nc += 0 if converged else 1
         e = est4 - true4
-        r.E.append(report(np.degrees(e[:m_]), "offsets"))
+        r.E.append(report(units.to_user(e[:m_], errors.offset_unit), "offsets"))
         r.M.append(report(e[m_:], "maemm"))
         r.comp.append(est4[:m_])
 
@@ -188,7 +190,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
                                  catch=(IdentificationError, ZerocalError), **loop_kw)
         for loop, n_id, t_id in runs:
             loop = None if isinstance(loop, BaseException) else loop
-            _record_loop(record, "tsvd-loop", loop, n_id, t_id, methods, paper4)
+            _record_loop(record, "tsvd-loop", loop, n_id, t_id, methods, paper4, errors)
     for ss, meas1, after1 in trials:
         for m in ("nlls-loop", "nlls-seq"):
             if m not in methods:
@@ -199,7 +201,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
                                         first=meas1, **loop_kw)
             except (IdentificationError, ZerocalError):
                 loop = None
-            _record_loop(record, m, loop, ident.n, ident.t, methods, paper4)
+            _record_loop(record, m, loop, ident.n, ident.t, methods, paper4, errors)
         if "nlls" in methods:
             first.append(meas1.readings)
         if "scipy" in methods:
@@ -210,7 +212,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
                    info["time_s"])
             if ok:
                 pos = [names.index(n) for n in offs]
-                sc_diff.append(np.max(np.abs(np.degrees(p_sc[pos] - ref.estimate[pos]))))
+                sc_diff.append(np.max(np.abs(units.to_user(p_sc[pos] - ref.estimate[pos], errors.offset_unit))))
                 sc_t.append(info["time_s"])
                 ip_t.append(ref.info["time_s"])
     if "nlls" in methods:  # the one-shot Ipopt of all first rounds in one batch (unconfirmed: the single path)
@@ -318,8 +320,8 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
     ranges = chunk_ranges(int(trials), chunk)
     out = {"settings": {"mechanism": robot.mechanism_name, "groups": [str(g) for g in truths], "trials": trials,
                         "K": K, "poses_mm": poses.tolist(),
-                        "params": list(names), "noise": {"sigma_scale_mm": noise.sigma_scale_mm,
-                                                         "sigma_servo_rad": noise.sigma_servo_rad},
+                        "params": list(names), "noise": noise.to_dict(robot),
+                        "offset_unit": errors.offset_user_unit,
                         "seed": seed, "methods": list(methods), "mu0_deg": mu0_deg,
                         "max_iter": max_iter, "chunk": chunk, "error_frame": "ours", **(settings or {})},
            "groups": {}}
@@ -336,12 +338,12 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
     report = report or _identity_report
     for gi, (g, err) in enumerate(prepared):
         try:
-            crlb = fisher.crlb_zero_offsets_deg(robot, th0, names, noise, err0=err) if not noise.is_zero else None
+            crlb = fisher.crlb_zero_offsets_user(robot, th0, names, noise, err0=err) if not noise.is_zero else None
         except ZerocalError:
             crlb = None
         mine = [r for r, o in zip(results, owner) if o == gi]  # chunk order
         gout = {"crlb_zero_offsets_deg": None if crlb is None else np.asarray(crlb).tolist(),
-                "set_deg": report(np.degrees(errors.take(err, offs)), "offsets").tolist(),
+                "set_deg": report(units.to_user(errors.take(err, offs), errors.offset_unit), "offsets").tolist(),
                 "methods": {}}
         for m in methods:
             gout["methods"][m] = _method_summary(m, [r["methods"][m] for r in mine], trials, crlb)
@@ -358,7 +360,7 @@ def compare(robot, truths: dict, poses, trials: int = 100, params="paper", noise
     out["execution"] = {"workers": workers, "scheduler": describe_scheduler(scheduler),
                         "chunks": len(tasks), "chunk_trials": chunk, "wall_s": time.perf_counter() - t_wall,
                         "wall_per_trial_ms": 1e3 * (time.perf_counter() - t_wall) / max(1, trials * len(prepared))}
-    return out
+    return units.rename_unit_keys(out, errors.offset_user_unit)
 
 
 def _method_summary(m, parts, trials, crlb) -> dict:

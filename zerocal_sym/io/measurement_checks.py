@@ -48,7 +48,8 @@ def _check_metadata(meta, meta_lines, src, mech) -> None:
     key = units.joint_key(mech, "compensation")
     comp = meta.get(key)
     if comp is not None and parse_offsets(comp, mech.m) is None:
-        raise DataFileError(f"'# {key}:' must be {mech.m} finite joint offsets in {mech.joint_user_unit}, one per "
+        raise DataFileError(f"'# {key}:' must be {mech.m} finite {units.joint_noun(mech).split()[1]} in "
+                            f"{mech.joint_user_unit}, one per "
                             f"joint ({', '.join(mech.joint_names)}), got {comp[:80]!r}",
                             where=f"{src}:{meta_lines[key]}")
 

@@ -114,6 +114,22 @@ class ResultFile:
         return from_user(self.zero_offsets_user, "rad" if self.offset_unit == "deg" else "mm")
 
     @property
+    def zero_offsets_deg(self) -> np.ndarray:
+        """The zero offsets in deg (revolute joints; :attr:`zero_offsets_user` for any)."""
+        self._revolute("zero_offsets_deg")
+        return self.zero_offsets_user
+
+    @property
+    def std_zero_offsets_deg(self) -> np.ndarray:
+        self._revolute("std_zero_offsets_deg")
+        return self.std_zero_offsets_user
+
+    def _revolute(self, what):
+        if self.offset_unit != "deg":
+            raise AttributeError(f"{what}: these zero offsets are in {self.offset_unit}; use "
+                                 f"{what.replace('_deg', '_user')}")
+
+    @property
     def m(self) -> int:
         return len(self.zero_offsets_user)
 

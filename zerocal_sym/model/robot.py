@@ -337,10 +337,10 @@ def _check_keys(keys: dict, where) -> None:
             lim = HOME_LIMIT[ju]
             if (not isinstance(v, list) or len(v) != mech.m
                     or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)):
-                raise RobotFileError(f"home must be a list of {mech.m} joint values ({ju}), got {v!r}",
+                raise RobotFileError(f"home must be a list of {mech.m} {units.joint_noun(mech)} ({ju}), got {v!r}",
                                      where=where(k))
             if not all(_is_finite_number(x) and abs(float(x)) <= lim for x in v):
-                raise RobotFileError(f"home must be {mech.m} finite joint values within +-{lim:g} {ju}, "
+                raise RobotFileError(f"home must be {mech.m} finite {units.joint_noun(mech)} within +-{lim:g} {ju}, "
                                      f"got [{', '.join(_shown(x) for x in v)}]", where=where(k))
             continue
         _check_number(k, v, "mm" if k in ws_cls.keys or k == "singularity_margin" else unit(k), where)

@@ -122,3 +122,16 @@ def unit_hint(mech) -> str:
     """``angles in degrees?`` or ``positions in mm?``: what to check when joints look wrong."""
     mech = getattr(mech, "mechanism", mech)
     return "angles in degrees?" if mech.joint_kind == "revolute" else "positions in mm?"
+
+
+def rename_unit_keys(obj, unit: str, stem: str = "_deg"):
+    """A report (nested dicts and lists) with every key ending in ``_deg`` renamed to end in ``_<unit>``: a report
+    of offsets written with the revolute spelling, for a mechanism whose offsets are in ``unit`` (``deg``: as is)."""
+    if unit == stem[1:]:
+        return obj
+    if isinstance(obj, dict):
+        return {(k[:-len(stem)] + "_" + unit if isinstance(k, str) and k.endswith(stem) else k):
+                rename_unit_keys(v, unit, stem) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [rename_unit_keys(v, unit, stem) for v in obj]
+    return obj

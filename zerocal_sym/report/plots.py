@@ -36,6 +36,8 @@ import io
 
 import numpy as np
 
+from zerocal_sym.model import units
+
 from zerocal_sym.io.files import atomic_write_bytes
 
 
@@ -193,7 +195,8 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
     err_true : ndarray, shape (q,)
         True source errors of the plant (rad, mm).
     compensation_deg : array_like, shape (m,)
-        Identified zero offsets (the compensation), deg, joint order.
+        Identified zero offsets (the compensation) in the joints' unit (deg for revolute joints, mm for prismatic
+        ones; the name keeps the revolute spelling), joint order.
     P : ndarray, shape (K, n), optional
         Target positions (default :func:`boundary_positions`).
     K : int
@@ -210,7 +213,7 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
     from zerocal_sym.identify.loop import position_errors
 
     P = boundary_positions(robot, K) if P is None else np.atleast_2d(np.asarray(P, float))
-    comp = np.radians(np.asarray(compensation_deg, float))
+    comp = units.joints_from_user(robot, np.asarray(compensation_deg, float))
     if comp.shape != (robot.m,):
         raise ValueError(f"compensation_deg must have one value per joint ({robot.m}), got shape {comp.shape}")
     plant = VirtualPlant(robot, err_true)
@@ -223,7 +226,7 @@ def boundary_errors(robot, err_true, compensation_deg, P=None, K: int = 42) -> d
         "after_mm": after,
         "max_before_mm": float(np.max(before)),
         "max_after_mm": float(np.max(after)),
-        "compensation_deg": np.degrees(comp),
+        "compensation_deg": units.joints_to_user(robot, comp),
         "workspace": robot.workspace.kind,
     }
 
