@@ -294,6 +294,12 @@ def run(args):
             raise ZerocalError(f"{meas.K} poses give {meas.K - 1} measured changes: fewer than the {len(names)} "
                                f"parameters {', '.join(names)}", where=args.data)
         pstd = _parse_named(args.prior_std, robot, names, "--prior-std", float)
+        if not pstd:  # a prior can make any set identifiable; without one, a set the poses cannot see is refused
+            from zerocal_sym.cli._checks import identifiability_problem
+
+            problem = identifiability_problem(robot, meas.theta_cmd, names, poses=f"the {meas.K} poses of the data")
+            if problem:
+                raise ZerocalError(f"--params {args.params}: {problem}", where=args.data)
         if any(v <= 0 for v in pstd.values()):
             raise ZerocalError("--prior-std must be positive")
         bounds = _parse_named(args.bound, robot, names, "--bound",
