@@ -11,11 +11,13 @@ Spec (paths relative to the spec file; angles in degrees, lengths in mm)::
     seed = 0                      # optional (default 0)
     trials = 1000000              # trials per cell
     chunk = 10000                 # trials per chunk file (default min(10000, trials))
-    params = "paper"              # identified parameters (default: the zero offsets and the MAEMM)
+    params = "paper"              # identified parameters (default: each mechanism's default set, e.g. the zero
+                                  # offsets and the MAEMM)
     streams = "common"            # "common" (default): trial t draws the same numbers in every cell;
                                   # "independent": each cell its own stream
     robots = ["paper", "examples/delta.toml"]   # "paper": the built-in robot; label: the file's stem
-    noise = ["paper", "scale-only", 0.5, 2]     # named, or factors of the paper's noise (default ["paper"])
+    noise = ["paper", "scale-only", 0.5, 2]     # named, or factors of each robot's default noise (the paper's
+                                                # for the paper's robot; a robot file's [noise]) (default ["paper"])
 
     [[design]]                    # one or more
     scheme = "auto"               # the robot's boundary scheme (or "paper" / "ring"), with
@@ -87,8 +89,7 @@ class Cell:
             "robot": {"label": self.robot_label, "name": r.name, "mechanism": r.mechanism_name,
                       "sha256": r.sha256},
             "design": self.design_label, "poses_mm": self.poses.tolist(),
-            "noise": {"label": self.noise_label, "sigma_scale_mm": self.noise.sigma_scale_mm,
-                      "sigma_servo_rad": self.noise.sigma_servo_rad},
+            "noise": {"label": self.noise_label, **self.noise.to_dict(r)},
             "truth": {"label": self.truth_label, "values": self.truth_user,
                       "units": {k: r.errors[k].user_unit for k in self.truth_user}},
             "params": list(self.params), "seed": study.seed, "stream": self.stream, "chunk": study.chunk,
@@ -192,18 +193,19 @@ def _noise_levels(raw, where):
             if v not in NAMED_NOISE:
                 raise StudySpecError(f"unknown noise level {v!r} (named: {', '.join(NAMED_NOISE)}; or a factor "
                                      "of the paper's noise)", where=where("noise"))
-            out.append((v, NoiseModel.named(v)))
+            out.append((v, lambda robot, v=v: NoiseModel.named(v, robot)))
         elif _is_num(v):
             if v < 0:
                 raise StudySpecError(f"noise factor {v!r} must be >= 0", where=where("noise"))
-            out.append((f"x{float(v):g}", NoiseModel.paper(float(v), float(v))))
+            out.append((f"x{float(v):g}", lambda robot, f=float(v): robot.noise.scaled(f, f)))
         elif isinstance(v, dict):
             bad = [k for k in v if k not in ("scale", "servo")]
             vals = [v.get("scale", 1.0), v.get("servo", 1.0)]
             if bad or not all(_is_num(x) and x >= 0 for x in vals):
                 raise StudySpecError(f"noise table {v!r}: keys scale and servo, factors >= 0 of the paper's "
                                      "two noise terms", where=where("noise"))
-            out.append((f"scale{float(vals[0]):g}-servo{float(vals[1]):g}", NoiseModel.paper(*map(float, vals))))
+            out.append((f"scale{float(vals[0]):g}-servo{float(vals[1]):g}",
+                        lambda robot, a=float(vals[0]), b=float(vals[1]): robot.noise.scaled(a, b)))
         else:
             raise StudySpecError(f"noise level {v!r}: a name or a number", where=where("noise"))
     labels = [lab for lab, _ in out]
@@ -394,7 +396,8 @@ def load_spec(path) -> Study:
                 if problem:
                     raise StudySpecError(f"robot {rl!r}, design {dlabel}: params = {params!r}: {problem}",
                                          where=wd(None))
-                for nl, noise in noises:
+                for nl, noise_of in noises:
+                    noise = noise_of(robot)  # the robot's: named, or factors of its default noise
                     cid = "_".join(_slug(x) for x in (rl, dlabel, nl, tlabel))
                     stream = 0 if streams == "common" else int.from_bytes(
                         hashlib.sha256(cid.encode()).digest()[:4], "little")
