@@ -65,3 +65,37 @@ def pytest_collection_modifyitems(items):
         return 2
 
     items[:] = sorted(items, key=rank)  # stable: the collection order within each rank
+
+
+# ----------------------------------------------------------------------------- test time per mechanism
+#: a test's mechanism: the first of these its node id names (parametrised ids, file names), else "generic"
+_MECHANISM_MARKS = {
+    "planar_2dof": ("planar_2dof", "paper"),
+    "delta_rotary": ("delta_rotary", "delta.toml", "_delta", "delta]"),
+    "delta_linear": ("delta_linear", "linear_delta", "lineardelta"),
+    "hexapod": ("hexapod",),
+}
+_TIMES: dict = {}
+
+
+def _mechanism_of(nodeid: str) -> str:
+    node = nodeid.lower()
+    for mech in ("hexapod", "delta_linear", "delta_rotary", "planar_2dof"):  # most specific first
+        if any(mark in node for mark in _MECHANISM_MARKS[mech]):
+            return mech
+    return "generic"
+
+
+def pytest_runtest_logreport(report):
+    """Sum each test's setup, call and teardown time under its mechanism (the controller sees every worker's)."""
+    t = _TIMES.setdefault(_mechanism_of(report.nodeid), [0.0, set()])
+    t[0] += report.duration
+    t[1].add(report.nodeid)
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The suite's time per mechanism (what each mechanism costs CI), after the results."""
+    if not _TIMES:
+        return
+    parts = [f"{m} {t:.1f} s ({len(ids)} tests)" for m, (t, ids) in sorted(_TIMES.items(), key=lambda kv: -kv[1][0])]
+    terminalreporter.write_line("test time per mechanism (summed over the workers): " + "; ".join(parts))

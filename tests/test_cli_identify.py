@@ -80,10 +80,13 @@ def test_not_converged_exits_nonzero_without_file(csv_file, capsys, tmp_path):
 
 
 def test_non_identifiable_offsets_exit_nonzero(csv_file, capsys, tmp_path):
+    """A parameter set the poses cannot identify is refused before any work (exit 2, one line naming the rigid
+    motions the distances do not see), as compare and study refuse it."""
     path, _ = csv_file(group=1, n=7)
     out = tmp_path / "res.json"
     rc, _, err = run_json(capsys, ["identify", str(path), "--params", "all", "--out", str(out)])
-    assert rc == 1 and not out.exists() and "not identifiable" in err
+    assert rc == 2 and not out.exists() and "not identifiable" in err and "rigid motion" in err
+    assert len(err.strip().splitlines()) == 1
 
 
 @pytest.mark.parametrize("argv, msg", [

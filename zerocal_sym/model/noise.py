@@ -28,8 +28,8 @@ from zerocal_sym.model import kinematics as kin
 
 #: the names of :meth:`NoiseModel.named` (the CLI's ``--noise`` choices): ``paper`` is the robot's default noise
 #: (the paper's Eqs. 34 and 35 unless the robot file or its mechanism gives its own), ``servo-only`` its joint term
-NOISE_NAMES = ("paper", "scale-only", "servo-only", "none", "default", "joint-only")
-#: names that stand for another
+NOISE_NAMES = ("paper", "scale-only", "servo-only", "none")
+#: names that stand for another (also accepted)
 NOISE_ALIASES = {"default": "paper", "joint-only": "servo-only"}
 
 
@@ -107,7 +107,7 @@ class NoiseModel:
 
         With ``robot`` the terms are the robot's (:meth:`of_robot`); without, the paper's.
         """
-        name = NOISE_ALIASES.get(name, name)
+        name = NOISE_ALIASES.get(name, name) if isinstance(name, str) else name
         if name not in NOISE_NAMES:
             raise ValueError(f"unknown noise model {name!r} (known: {', '.join(NOISE_NAMES)})")
         base = cls.paper() if robot is None else cls.of_robot(robot)
