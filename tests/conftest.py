@@ -68,7 +68,7 @@ def pytest_collection_modifyitems(items):
 
 
 # ----------------------------------------------------------------------------- test time per mechanism
-#: a test's mechanism: the first of these its node id names (parametrised ids, file names), else "generic"
+#: a test's mechanism: the first of these its node id names (parametrised ids, file names), else unnamed
 _MECHANISM_MARKS = {
     "planar_2dof": ("planar_2dof", "paper"),
     "delta_rotary": ("delta_rotary", "delta.toml", "_delta", "delta]"),
@@ -83,7 +83,7 @@ def _mechanism_of(nodeid: str) -> str:
     for mech in ("hexapod", "delta_linear", "delta_rotary", "planar_2dof"):  # most specific first
         if any(mark in node for mark in _MECHANISM_MARKS[mech]):
             return mech
-    return "generic"
+    return "unnamed (mostly the paper's robot)"
 
 
 def pytest_runtest_logreport(report):
