@@ -25,7 +25,9 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 #: mechanism -> its robot for the contract suite, and the boundary scheme's n for identification
 ROBOTS = {"planar_2dof": (paper_robot, 3), "delta_rotary": (lambda: load_robot(EXAMPLES / "delta.toml"), 6),
           "delta_linear": (lambda: load_robot(EXAMPLES / "linear_delta.toml"), 6),
-          "hexapod": (lambda: load_robot(EXAMPLES / "hexapod.toml"), 64)}
+          "hexapod": (lambda: load_robot(EXAMPLES / "hexapod.toml"), 16)}
+#: Monte Carlo trials of the efficiency test (an identification of the hexapod costs ~0.1 s of CPU at K = 16)
+MC_TRIALS = {"hexapod": 100}
 
 
 def test_every_registered_mechanism_has_a_contract_robot():
@@ -165,7 +167,8 @@ def test_noise_free_recovery_of_every_identifiable_parameter(mrobot, rng):
 
 @pytest.mark.slow
 def test_monte_carlo_rms_of_the_zero_offsets_is_the_crlb(mrobot, scheme):
-    """Ipopt on the exact model is efficient: RMS within 10 % of the CRLB, each offset (400 trials)."""
+    """Ipopt on the exact model is efficient: RMS within 10 % of the CRLB, each offset (400 trials; a mechanism
+    with fewer trials gets the tolerance of the same confidence, 10 % * sqrt(400 / trials))."""
     noise = mrobot.noise
     names = mrobot.errors.resolve("default")
     truth = mrobot.errors.embed(names, mrobot.errors.take(_truth(mrobot), names))
@@ -173,16 +176,17 @@ def test_monte_carlo_rms_of_the_zero_offsets_is_the_crlb(mrobot, scheme):
     plant = VirtualPlant(mrobot, truth)
     crlb = fisher.crlb_zero_offsets_user(mrobot, th, "paper", noise, err0=truth)
     E, misfits = [], 0
-    for trial in range(400):
+    trials = MC_TRIALS.get(mrobot.mechanism_name, 400)
+    for trial in range(trials):
         meas = Measurements(theta_cmd=th, readings=plant.measure(th, noise, np.random.default_rng([17, trial])))
         # every round counts in the RMS: the fit check rejects clean rounds at its level alpha = 0.001
         res = identify_nlls(mrobot, meas, "paper", noise=noise, accept_misfit=True)
         assert res.success, res.status
         misfits += res.info["fit"]["rejected"]
         E.append(res.zero_offsets - mrobot.errors.take(truth, mrobot.errors.zero_offsets))
-    assert misfits <= 3  # expected 0.4 of 400; P(>= 4) < 1e-3
+    assert misfits <= 3  # expected 0.4 of 400 (fewer with fewer trials); P(>= 4) < 1e-3
     rms = units.to_user(np.sqrt(np.mean(np.square(E), axis=0)), mrobot.errors.offset_unit)
-    np.testing.assert_allclose(rms / crlb, 1.0, atol=0.10)
+    np.testing.assert_allclose(rms / crlb, 1.0, atol=0.10 * np.sqrt(400 / trials))
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/hexapod.py
-inputs hash: 0c3bf17210d0e3f8
+inputs hash: 1720fd67ae42df52
 sympy: 1.14.0
 """
 import casadi as ca
@@ -487,9 +487,9 @@ def _fk_start(g):
 
 
 def _fk(theta, g):
-    """Forward kinematics: 10 Newton steps on the loop closure from fk_start; NaN where max|f| > 1e-06 then."""
+    """Forward kinematics: 7 Newton steps on the loop closure from fk_start; NaN where max|f| > 1e-06 then."""
     P = _fk_start(g)[0]
-    for _ in range(10):
+    for _ in range(7):
         f, f_P = _fk_residual(P, theta, g)
         P = P - ca.solve(f_P, f)
     f = _fk_residual(P, theta, g)[0]
