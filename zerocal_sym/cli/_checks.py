@@ -15,7 +15,9 @@ The rules:
   ``--method tsvd`` and the tsvd-only ones (``--truncation --rule``) with
   nlls; ``--truncation`` together with ``--rule`` (a fixed t has no rule);
   ``compare``'s loop settings (``--mu0 --max-iter``) without a loop method;
-  ``compensate --max-offset-deg`` without a result; ``--report`` with
+  ``compensate --max-offset-deg`` without a result, its ``--endstop-mm
+  --homed-height-mm`` with the csv table and its poses with a controller
+  format; ``--report`` with
   ``--json`` (the JSON holds the report); ``regen``/``study --robot``.
 * **Numbers**: seeds are integers >= 0; counts in their range (``--n`` at most
   :data:`MAX_N` poses per boundary); thresholds finite and positive.
@@ -189,6 +191,31 @@ def _identify(args) -> None:
 
 
 def _compensate(args) -> None:
+    fmt = getattr(args, "format", "csv")
+    if fmt == "csv":
+        bad = _given(args, "endstop_mm", "homed_height_mm")
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: for a controller's configuration (--format klipper or rrf), not the "
+                               "csv table")
+    else:
+        bad = _given(args, "poses", "scheme", "n") + (["template"] if args.template else [])
+        if bad:
+            raise ZerocalError(f"{_opts(bad)}: not with --format {fmt} (the controller's configuration takes the "
+                               "offsets of RESULT.json, no poses)")
+        if args.result is None:
+            raise ZerocalError(f"--format {fmt} writes the controller's configuration from RESULT.json: give it")
+        if fmt == "klipper" and _given(args, "homed_height_mm"):
+            raise ZerocalError("--homed-height-mm is RRF's M665 H: for --format rrf only")
+        if args.endstop_mm is not None:
+            from zerocal_sym.io.controllers import parse_endstops
+
+            try:
+                parse_endstops(args.endstop_mm, fmt)
+            except ValueError as exc:
+                raise ZerocalError(str(exc)) from None
+        h = args.homed_height_mm
+        if h is not None and not (math.isfinite(h) and 0 < h <= 1e5):
+            raise ZerocalError(f"--homed-height-mm must be a positive number of mm (RRF's M665 H), got {h:g}")
     bad = _given(args, "max_offset_deg", "max_offset")
     if args.result is None and bad:
         raise ZerocalError(f"{_opts(bad)} checks the offsets of RESULT.json: give the result (without one "

@@ -15,7 +15,16 @@ Outputs (CSV, written atomically to --out, or printed):
   column per joint of the robot's mechanism);
 * with ``--template`` as well: a measurement file to fill in (the format of
   ``zerocal identify``, ``reading_mm`` blank) with the compensated commands --
-  the next measurement round, or without RESULT the first one.
+  the next measurement round, or without RESULT the first one;
+* ``--format klipper`` / ``--format rrf`` (a linear Delta): the controller's
+  configuration instead of the table -- Klipper's ``[printer]`` and
+  ``[stepper_a]``..``[stepper_c]`` values, or RepRapFirmware's ``M665`` and
+  ``M666`` lines -- with the endstops corrected by the offsets
+  (``position_endstop`` / the ``M666`` adjustment + offset; towers matched
+  to the controller's by their azimuth).  ``--endstop-mm`` gives the
+  controller's current values (Klipper's ``position_endstop``, RRF's ``M666``
+  adjustments; one, or three in the controller's tower order a,b,c / X,Y,Z);
+  without them the corrections are written as comments.
 
 Examples:
 
@@ -23,6 +32,8 @@ Examples:
     zerocal compensate result.json --scheme paper --n 3 --out commands.csv
     zerocal compensate --scheme paper --n 3 --template --out round1.csv
     zerocal compensate result.json --robot examples/delta.toml --scheme ring --n 6 --template --out round2.csv
+    zerocal compensate result.json --robot examples/linear_delta.toml --format klipper --endstop-mm 300
+    zerocal compensate result.json --robot examples/linear_delta.toml --format rrf --endstop-mm 0,0,0
 """
 NAME = "compensate"
 HELP = "write the compensation table / compensated joint commands from a result"
@@ -47,7 +58,16 @@ def add_arguments(p):
                         "joints (default 10 deg or 10 mm: not a zero offset)")
     p.add_argument("--max-offset-deg", type=float, default=None, metavar="DEG",
                    help="the same for revolute joints, in deg (the former spelling)")
-    p.add_argument("--out", metavar="FILE.csv", default=None, type=OutputFile(), help="output file (default: print)")
+    p.add_argument("--format", choices=["csv", "klipper", "rrf"], default="csv",
+                   help="csv: the compensation table (any mechanism, the default); klipper / rrf: a linear delta's "
+                        "controller configuration with the endstops corrected")
+    p.add_argument("--endstop-mm", metavar="V[,V,V]", default=None,
+                   help="klipper / rrf: the controller's current endstop values, mm (Klipper: position_endstop of "
+                        "stepper_a,b,c; RRF: the M666 X,Y,Z adjustments): one, or three in that order "
+                        "(default: the corrections as comments)")
+    p.add_argument("--homed-height-mm", type=float, default=None, metavar="H",
+                   help="rrf: the M665 H (homed height, mm) to write (default: left out, RRF keeps its own)")
+    p.add_argument("--out", metavar="FILE", default=None, type=OutputFile(), help="output file (default: print)")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
 
 
@@ -79,6 +99,10 @@ def run(args):
 
     robot = load_robot_arg(args)
     joints = robot.mechanism.joint_names
+    if args.format != "csv":  # a mechanism or robot the format cannot describe: refused before any work
+        from zerocal_sym.io.controllers import describe
+
+        describe(args.format, robot)
     has_poses = args.poses is not None or args.scheme is not None
     if args.result is None and not (args.template and has_poses):
         raise ZerocalError("give RESULT.json (or, for a first measurement round without compensation, "
@@ -104,7 +128,13 @@ def run(args):
     meta = {"robot_sha256": robot.sha256}
     if args.result is not None:
         meta["result"] = args.result
-    if not has_poses:
+    if args.format != "csv":
+        from zerocal_sym.io.controllers import FORMATS, format_controller, parse_endstops
+
+        endstops = None if args.endstop_mm is None else parse_endstops(args.endstop_mm, args.format)
+        text = format_controller(args.format, robot, res, endstops, args.homed_height_mm, {"result": args.result})
+        what, K = f"{FORMATS[args.format].title} configuration", 0
+    elif not has_poses:
         text, what, K = format_compensation(res, {"result": args.result}, mechanism=robot), "compensation table", 0
     else:
         if args.poses is not None:
@@ -128,7 +158,7 @@ def run(args):
     if args.json:
         print(to_json({units.joint_key(robot, "zero_offsets"): [float(v) for v in offsets], "joints": list(joints),
                        "mechanism": robot.mechanism_name, "sign_convention": sign_convention(units.joint_unit(robot)),
-                       "output": args.out, "kind": what, "poses": K}))
+                       "output": args.out, "kind": what, "format": args.format, "poses": K}))
     elif args.out:
         print(f"wrote {what} ({K} poses) to {args.out}" if K else f"wrote {what} to {args.out}")
         print(f"offsets [{units.joint_unit(robot)}]: " + ", ".join(f"{j} {v:+.6f}" for j, v in zip(joints, offsets))
