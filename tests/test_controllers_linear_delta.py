@@ -214,7 +214,7 @@ def _effector(robot, carriages_by_joint):
 def klipper_effector(robot, text, P, true_home):
     """Where the effector goes when Klipper, configured by ``text``, is commanded to ``P``.
 
-    Klipper (klippy/kinematics/delta.py): the tower of stepper k at ``delta_radius (cos angle, sin angle)``; the
+    Klipper's delta kinematics: the tower of stepper k at ``delta_radius (cos angle, sin angle)``; the
     carriage for P at ``z + sqrt(arm^2 - |xy - tower|^2)``; after homing it believes the carriage at
     ``position_endstop + sqrt(arm^2 - delta_radius^2)``, where the carriage of tower j truly is ``true_home[j]``.
     """
@@ -234,7 +234,7 @@ def klipper_effector(robot, text, P, true_home):
 def rrf_effector(robot, text, P, true_home):
     """Where the effector goes when RRF, configured by ``text``, is commanded to ``P``.
 
-    RRF (LinearDeltaKinematics.cpp): towers from R and the angle corrections (``Recalc``), the carriage for P at
+    RRF's linear-delta kinematics: towers from R and the angle corrections (``Recalc``), the carriage for P at
     ``sqrt(L^2 - |xy - tower|^2) + z``, after homing believed at ``H + sqrt(L^2 - R^2) + adjustment``.
     """
     m665, m666, _ = parse_rrf(text)
@@ -419,3 +419,22 @@ def test_cli_output_over_the_input_refused(capsys, identified):
     _, err = zc(capsys, "compensate", identified, "--robot", LINEAR, "--format", "klipper", "--out", identified,
                 expect=2)
     assert len(err.strip().splitlines()) == 1 and identified.read_text() == before
+
+
+def test_the_documented_examples_read_back(tmp_path):
+    """docs/data-format.md's pasted exports: each corrected value is the current one plus its tower's offset comment,
+    and the file's towers are the robot file's by azimuth (a = s2, b = s3, c = s1)."""
+    doc = (ROOT / "docs" / "data-format.md").read_text()
+    section = doc.split("## Controller exports", 1)[1].split("\n## ", 1)[0]
+    blocks = re.findall(r"```\n(.*?)```", section, flags=re.S)
+    klipper = next(b for b in blocks if "[stepper_a]" in b)
+    rrf = next(b for b in blocks if b.startswith("; zerocal"))
+    sec, _ = parse_klipper(klipper)
+    offsets = {m.group(1): float(m.group(2)) for m in re.finditer(r"# tower (s\d): offset_mm (\S+)", klipper)}
+    for name, joint in zip("abc", ("s2", "s3", "s1")):
+        assert sec[f"stepper_{name}"]["position_endstop"] == pytest.approx(300 + offsets[joint], abs=tol("klipper"))
+    m665, m666, _ = parse_rrf(rrf)
+    current = dict(zip("XYZ", (0.12, -0.3, 0.05)))  # the documented --endstop-mm
+    for name, joint in zip("XYZ", ("s2", "s3", "s1")):
+        assert m666[name] == pytest.approx(current[name] + offsets[joint], abs=tol("rrf"))
+    assert m665["H"] == [250.0] and m665["R"] == [120.0]
