@@ -56,7 +56,8 @@ def result(offsets=FINE_S, std=(0.009, 0.0093, 0.0089), estimate=None):
 # --------------------------------------------------------------------------- the parsers (of the lines we write)
 
 def parse_klipper(text):
-    """``{section: {key: float | str}}`` of the value lines; ``corrections[stepper]``: the ``<current> +- d`` comments."""
+    """``{section: {key: float | str}}`` of the value lines, and ``{section: d}`` of the ``<current> +- d``
+    comments."""
     sections, corrections, cur = {}, {}, None
     for line in text.splitlines():
         s = line.strip()
@@ -381,7 +382,7 @@ def test_cli_other_mechanisms_refused(capsys, tmp_path, robot, fmt):
 
 @pytest.mark.parametrize("extra,pattern", [
     (("--format", "csv", "--endstop-mm", "300"), r"--endstop-mm: for a controller's configuration"),
-    (("--homed-height-mm", "250"), r"--homed-height-mm: for a controller's configuration"),
+    (("--homed-height-mm", "250"), r"RRF's M665 H: for --format rrf only"),
     (("--format", "klipper", "--homed-height-mm", "250"), r"RRF's M665 H: for --format rrf only"),
     (("--format", "klipper", "--scheme", "ring"), r"--scheme: not with --format klipper"),
     (("--format", "rrf", "--endstop-mm", "1,2"), r"--endstop-mm '1,2': one number .* \(X, Y, Z\)"),

@@ -192,10 +192,11 @@ def _identify(args) -> None:
 
 def _compensate(args) -> None:
     fmt = getattr(args, "format", "csv")
+    if fmt != "rrf" and _given(args, "homed_height_mm"):
+        raise ZerocalError("--homed-height-mm is RRF's M665 H: for --format rrf only")
     if fmt == "csv":
-        bad = _given(args, "endstop_mm", "homed_height_mm")
-        if bad:
-            raise ZerocalError(f"{_opts(bad)}: for a controller's configuration (--format klipper or rrf), not the "
+        if _given(args, "endstop_mm"):
+            raise ZerocalError("--endstop-mm: for a controller's configuration (--format klipper or rrf), not the "
                                "csv table")
     else:
         bad = _given(args, "poses", "scheme", "n") + (["template"] if args.template else [])
@@ -204,8 +205,6 @@ def _compensate(args) -> None:
                                "offsets of RESULT.json, no poses)")
         if args.result is None:
             raise ZerocalError(f"--format {fmt} writes the controller's configuration from RESULT.json: give it")
-        if fmt == "klipper" and _given(args, "homed_height_mm"):
-            raise ZerocalError("--homed-height-mm is RRF's M665 H: for --format rrf only")
         if args.endstop_mm is not None:
             from zerocal_sym.io.controllers import parse_endstops
 

@@ -5,7 +5,7 @@ offset, so the controller subtracts the identified offset:
 
     theta_cmd = IK(P) - offset
 
-Outputs (CSV, written atomically to --out, or printed):
+Outputs (written atomically to --out, or printed):
 
 * no pose list: the compensation table ``joint,offset_deg,std_deg``;
 * with ``--poses FILE.csv`` (``[pose,]x_mm,y_mm[,z_mm]``) or ``--scheme S --n N``
@@ -36,7 +36,7 @@ Examples:
     zerocal compensate result.json --robot examples/linear_delta.toml --format rrf --endstop-mm 0,0,0
 """
 NAME = "compensate"
-HELP = "write the compensation table / compensated joint commands from a result"
+HELP = "write the compensation table / compensated joint commands / a delta controller's configuration from a result"
 
 
 def add_arguments(p):
