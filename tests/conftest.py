@@ -14,6 +14,13 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("ZEROCAL_COMPILE", "never")
 
 
+def pytest_addoption(parser):
+    parser.addoption("--contract-robot", action="append", default=[], metavar="ROBOT.toml",
+                     help="also run the mechanism contract suite (tests/test_contract.py) on this robot file's "
+                          "mechanism (repeatable): a mechanism of your own, by its robot file's "
+                          "mechanism_module (docs/new-mechanism.md)")
+
+
 @pytest.fixture(scope="session")
 def robot():
     from zerocal_sym.model.robot import paper_robot
@@ -60,7 +67,7 @@ def pytest_collection_modifyitems(items):
     def rank(item):
         if item.nodeid.endswith(".ipynb") or ".ipynb::" in item.nodeid:
             return 0
-        if {"derived", "generated"} & set(getattr(item, "fixturenames", ())):
+        if {"derived", "generated", "symbolic"} & set(getattr(item, "fixturenames", ())):
             return 1
         return 2
 
