@@ -221,18 +221,24 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     meta, meta_lines, rows = _split_csv(text, src, "# zerocal measurements", FORMAT_VERSION)
     declared = _declared_mechanism(meta, meta_lines, src, robot)
     mech, reason = read_as(robot, declared)
-    _check_metadata(meta, meta_lines, src, mech)
+
+    def fits(check, *args):
+        """``check(*args)``; a file naming no mechanism is told what it was read as when it does not fit (its
+        columns or its per-joint metadata may be another mechanism's)."""
+        try:
+            check(*args)
+        except DataFileError as exc:
+            if declared is None:
+                raise with_reading_hint(exc, mech, reason) from None
+            raise
+
+    fits(_check_metadata, meta, meta_lines, src, mech)
     cols = measurement_columns(mech)
     if not rows:
         raise DataFileError(f"empty file: no header line and no data (expected the header {cols.example})",
                             where=src)
     header_line, header = rows[0]
-    try:
-        _check_header(header, header_line, src, cols.allowed, cols.required, cols.example)
-    except DataFileError as exc:
-        if declared is None:  # say what the file was read as: the columns may be another mechanism's
-            raise with_reading_hint(exc, mech, reason) from None
-        raise
+    fits(_check_header, header, header_line, src, cols.allowed, cols.required, cols.example)
     has_pose = [c in header for c in cols.pose]
     if any(has_pose) and not all(has_pose):
         raise DataFileError(_go_together(cols.pose), where=f"{src}:{header_line}")
