@@ -278,7 +278,7 @@ def get_mechanism_of(spec=None):
     ValueError
         An unknown mechanism name.
     """
-    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, Mechanism, get_mechanism
+    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, Mechanism, get_mechanism, is_known
 
     if spec is None:
         return get_mechanism(DEFAULT_MECHANISM)
@@ -286,7 +286,7 @@ def get_mechanism_of(spec=None):
         return spec
     if not isinstance(spec, str):
         return spec.mechanism
-    if spec not in known_names():
+    if not is_known(spec):
         raise ValueError(f"unknown mechanism {spec!r} (known: {', '.join(known_names())})")
     return get_mechanism(spec)
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import MECHANISM_KEY, known_names, unknown_mechanism_message
+from zerocal_sym.io.csvtext import MECHANISM_KEY, unknown_mechanism_message
 from zerocal_sym.io.duplicates import first_duplicate
 from zerocal_sym.io.measurement_columns import MeasurementColumns, measurement_columns
 from zerocal_sym.model.measurements import Measurements
@@ -53,11 +53,13 @@ def _check_metadata(meta, meta_lines, src, mech) -> None:
 
 def _declared_mechanism(meta, meta_lines, src, robot):
     """The file's ``# mechanism:`` (None without); unknown or not the robot's: DataFileError."""
+    from zerocal_sym.model.mechanism import is_known
+
     declared = meta.get(MECHANISM_KEY)
     if declared is None:
         return None
     where = f"{src}:{meta_lines[MECHANISM_KEY]}"
-    if declared not in known_names():
+    if not is_known(declared):
         raise DataFileError(unknown_mechanism_message(declared), where=where)
     if robot is not None and declared != robot.mechanism_name:
         raise DataFileError(f"measured with mechanism {declared}, the robot file is {robot.mechanism_name} "

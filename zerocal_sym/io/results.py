@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (_json_line, _load_json, _read_text, get_mechanism_of, known_names, read_as,
+from zerocal_sym.io.csvtext import (_json_line, _load_json, _read_text, get_mechanism_of, read_as,
                                     unknown_mechanism_message, with_reading_hint)
 
 #: the sign convention of every file that carries offsets (a results file's ``compensation.sign_convention``)
@@ -175,10 +175,12 @@ def _find_sha(obj, text, src):
 
 def _find_mechanism(obj, text, src):
     """The ``mechanism`` key (and ``robot.mechanism``, which must agree), checked; None without."""
+    from zerocal_sym.model.mechanism import is_known
+
     named = [(k, v) for k, v in (("mechanism", obj.get("mechanism")),
                                  ("robot.mechanism", _robot_block(obj, text, src).get("mechanism"))) if v is not None]
     for k, v in named:
-        if not isinstance(v, str) or v not in known_names():
+        if not isinstance(v, str) or not is_known(v):
             raise DataFileError(f"key '{k}': " + unknown_mechanism_message(v if isinstance(v, str) else
                                                                          json.dumps(v)[:60]),
                                 where=_where(text, "mechanism", src))

@@ -78,6 +78,12 @@ def known_mechanisms() -> dict:
     return {**_entry_points(), **_EXTERNAL, **REGISTRY}
 
 
+def is_known(name: str) -> bool:
+    """Whether :func:`known_mechanisms` has ``name`` (the installed packages' entry points read only when it is
+    neither built in nor registered: reading them takes milliseconds)."""
+    return name in REGISTRY or name in _EXTERNAL or name in _entry_points()
+
+
 def register_mechanism(name: str, module) -> None:
     """Make the generated module ``module`` (a dotted name, or a path to a ``.py`` file) mechanism ``name``.
 
