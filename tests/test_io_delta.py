@@ -155,6 +155,23 @@ def test_planar_file_without_mechanism_line_still_loads(tmp_path, robot):
         np.testing.assert_array_equal(m.readings, ref.readings)
 
 
+def test_what_a_file_was_read_as_is_said_only_for_a_misfit_of_its_columns(tmp_path, robot):
+    """A header error that is no column mismatch (the separator) says nothing of the mechanism; missing or
+    unexpected columns in a file naming none say what it was read as."""
+    text = "\n".join(ln for ln in PLANAR_EXAMPLE.read_text().split("\n") if not ln.startswith("# mechanism"))
+    hl = line_of(text, "pose,")
+    lines = text.split("\n")
+    lines[hl - 1] = lines[hl - 1].replace(",", ";")
+    p = write(tmp_path, "\n".join(lines), "sep.csv")
+    msg = expect_error(lambda: data.load_measurements(p, robot=robot), p, r"the separator must be a comma", line=hl)
+    assert "names no mechanism" not in msg
+    lines = text.split("\n")
+    lines[hl - 1] = lines[hl - 1].replace("reading_mm", "reading")
+    p = write(tmp_path, "\n".join(lines), "col.csv")
+    expect_error(lambda: data.load_measurements(p, robot=robot), p, r"unexpected column\(s\): 'reading' .*; the file "
+                 r"names no mechanism and is read as mechanism planar_2dof, the robot's", line=hl)
+
+
 def test_unknown_mechanism_line(tmp_path, robot):
     """The message lists every mechanism known now (built in, installed, registered by a robot file)."""
     text = PLANAR_EXAMPLE.read_text().replace("# mechanism: planar_2dof", "# mechanism: no_such_mechanism")

@@ -29,6 +29,11 @@ from pathlib import Path
 
 from zerocal_sym.errors import DataFileError
 
+class ColumnMismatch(DataFileError):
+    """A header whose columns are not the expected ones (unexpected or missing columns): maybe another
+    mechanism's, so a reader says which mechanism it read the file as (:func:`with_reading_hint`)."""
+
+
 #: metadata key naming the mechanism a file belongs to (``# mechanism: delta_rotary``)
 MECHANISM_KEY = "mechanism"
 #: the metadata keys zerocal reads: one value each (a second line with another value is an error); other
@@ -145,11 +150,11 @@ def _check_header(header, header_line, src, allowed, required, example):
             hints.append(f"'{c}' (column {header.index(c) + 1}" + (f"; did you mean '{close[0]}'?)" if close else ")"))
         missing = [c for c in required if c not in header]
         miss = f"; missing: {', '.join(missing)}" if missing else ""
-        raise DataFileError(f"unexpected column(s): {', '.join(hints)}{miss}; allowed: {', '.join(allowed)}",
-                            where=where)
+        raise ColumnMismatch(f"unexpected column(s): {', '.join(hints)}{miss}; allowed: {', '.join(allowed)}",
+                             where=where)
     missing = [c for c in required if c not in header]
     if missing:
-        raise DataFileError(f"missing column(s): {', '.join(missing)} (header must be {example})", where=where)
+        raise ColumnMismatch(f"missing column(s): {', '.join(missing)} (header must be {example})", where=where)
 
 
 def _number(text: str, where: str, col: str, j: int) -> float:

@@ -52,8 +52,8 @@ import io
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (MECHANISM_KEY, _check_header, _check_pose_numbers, _format_meta, _go_together,
-                                    _read_text, _rows_to_array, _split_csv, get_mechanism_of, read_as,
+from zerocal_sym.io.csvtext import (MECHANISM_KEY, ColumnMismatch, _check_header, _check_pose_numbers, _format_meta,
+                                    _go_together, _read_text, _rows_to_array, _split_csv, get_mechanism_of, read_as,
                                     with_reading_hint)
 from zerocal_sym.io.files import atomic_write_text
 from zerocal_sym.io.measurement_checks import (_check_duplicates, _check_metadata, _declared_mechanism,
@@ -222,12 +222,12 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     declared = _declared_mechanism(meta, meta_lines, src, robot)
     mech, reason = read_as(robot, declared)
 
-    def fits(check, *args):
+    def fits(check, *args, errors=DataFileError):
         """``check(*args)``; a file naming no mechanism is told what it was read as when it does not fit (its
         columns or its per-joint metadata may be another mechanism's)."""
         try:
             check(*args)
-        except DataFileError as exc:
+        except errors as exc:
             if declared is None:
                 raise with_reading_hint(exc, mech, reason) from None
             raise
@@ -238,7 +238,7 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
         raise DataFileError(f"empty file: no header line and no data (expected the header {cols.example})",
                             where=src)
     header_line, header = rows[0]
-    fits(_check_header, header, header_line, src, cols.allowed, cols.required, cols.example)
+    fits(_check_header, header, header_line, src, cols.allowed, cols.required, cols.example, errors=ColumnMismatch)
     has_pose = [c in header for c in cols.pose]
     if any(has_pose) and not all(has_pose):
         raise DataFileError(_go_together(cols.pose), where=f"{src}:{header_line}")

@@ -17,8 +17,8 @@ import math
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, _check_header, _check_pose_numbers, _json_line, _load_json,
-                                    _read_text, _rows_to_array, _split_csv, pose_columns, read_as,
+from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, ColumnMismatch, _check_header, _check_pose_numbers, _json_line,
+                                    _load_json, _read_text, _rows_to_array, _split_csv, pose_columns, read_as,
                                     with_reading_hint)
 
 
@@ -88,7 +88,7 @@ def load_poses(path, robot=None) -> np.ndarray:
         header_line, header = rows[0]
         try:
             _check_header(header, header_line, src, ("pose",) + cols, cols, example)
-        except DataFileError as exc:
+        except ColumnMismatch as exc:
             raise with_reading_hint(exc, mech, reason) from None  # another mechanism's columns?
         if len(rows) == 1:
             raise DataFileError("no data rows after the header", where=f"{src}:{header_line}")
