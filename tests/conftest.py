@@ -21,6 +21,25 @@ def pytest_addoption(parser):
                           "mechanism_module (docs/new-mechanism.md)")
 
 
+#: the robots of --contract-robot, loaded once when pytest starts: [(path, Robot)]
+CONTRACT_ROBOTS = pytest.StashKey()
+
+
+def pytest_configure(config):
+    """Load the ``--contract-robot`` files before collection: a bad one is a one-line usage error."""
+    paths = config.getoption("contract_robot", default=None) or []
+    robots = []
+    if paths:
+        from zerocal_sym.errors import ZerocalError
+        from zerocal_sym.model.robot import load_robot
+    for path in paths:
+        try:
+            robots.append((path, load_robot(path)))
+        except ZerocalError as exc:
+            raise pytest.UsageError(f"--contract-robot: {exc}") from None
+    config.stash[CONTRACT_ROBOTS] = robots
+
+
 @pytest.fixture(scope="session")
 def robot():
     from zerocal_sym.model.robot import paper_robot

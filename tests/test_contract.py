@@ -23,7 +23,6 @@ import numpy as np
 import pytest
 
 from zerocal_sym.cli._common import default_n
-from zerocal_sym.errors import ZerocalError
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify import identifiability as idf
 from zerocal_sym.identify.nlls import identify_nlls
@@ -51,14 +50,13 @@ _CASES = pytest.StashKey()
 
 def contract_cases(config) -> dict:
     """Label -> (robot factory, the boundary scheme's n): every built-in mechanism (``ROBOTS``), then the robot
-    file of each ``--contract-robot`` (labelled by its mechanism, or mechanism-file stem for a second of one)."""
+    file of each ``--contract-robot`` (labelled by its mechanism, or mechanism-file stem for a second of one;
+    loaded by tests/conftest.py when pytest starts)."""
     if _CASES not in config.stash:
+        from conftest import CONTRACT_ROBOTS
+
         cases = {name: ROBOTS[name] for name in sorted(REGISTRY)}
-        for path in config.getoption("contract_robot", default=[]):
-            try:
-                robot = load_robot(path)
-            except ZerocalError as exc:
-                raise pytest.UsageError(f"--contract-robot {path}: {exc}") from None
+        for path, robot in config.stash.get(CONTRACT_ROBOTS, []):
             label = robot.mechanism_name
             if label in cases:
                 label = f"{label}-{Path(path).stem}"

@@ -287,3 +287,12 @@ def test_a_mechanism_from_an_installed_package_entry_point(monkeypatch, tmp_path
     np.testing.assert_array_equal(robot.geometry, load_robot(ROOT / "examples" / "paper_robot.toml").geometry)
     monkeypatch.setattr(md, "entry_points", real)
     assert "ep_fivebar" not in mechanism_module.known_mechanisms()
+
+
+def test_a_bad_contract_robot_is_a_one_line_usage_error(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "pytest", str(ROOT / "tests" / "test_contract.py"), "--contract-robot",
+                        "no_such_robot.toml", "-p", "no:cacheprovider"], capture_output=True, text=True, cwd=tmp_path,
+                       timeout=600, env={**os.environ, "PYTEST_ADDOPTS": ""})
+    assert r.returncode == pytest.ExitCode.USAGE_ERROR, r.stdout + r.stderr
+    assert "ERROR: --contract-robot: no_such_robot.toml: robot file not found" in r.stderr, r.stderr
+    assert "Traceback" not in r.stdout + r.stderr
