@@ -43,12 +43,17 @@ GENERATED_DIR = HERE.parent / "zerocal_sym" / "generated"
 
 
 def _relative(path) -> str:
-    """``derivations/...`` path of a derivation source."""
-    return Path(path).resolve().relative_to(HERE.parent).as_posix()
+    """How the header and the hash name a derivation source: ``derivations/...`` for the package's own files,
+    the file name for one outside the package (a user's derivation: its directory may move)."""
+    path = Path(path).resolve()
+    try:
+        return path.relative_to(HERE.parent).as_posix()
+    except ValueError:
+        return path.name
 
 
 def input_hash(sources) -> str:
-    """SHA-256 (first 16 hex digits) over the derivation sources."""
+    """SHA-256 (first 16 hex digits) over the derivation sources (their names, :func:`_relative`, and bytes)."""
     h = hashlib.sha256()
     for path in sorted(sources, key=_relative):
         h.update(_relative(path).encode())
@@ -176,8 +181,20 @@ def emit_function(fname: str, spec: dict, printer) -> str:
     return "\n".join(lines)
 
 
-def render(mech, sources) -> str:
-    """The full generated module for ``mech`` as a string."""
+def render(mech, sources, derivation: str | None = None) -> str:
+    """The full generated module for ``mech`` as a string.
+
+    Parameters
+    ----------
+    mech : SymbolicMechanism
+        Derived (:func:`derivations.mechanism.derive`).
+    sources : list of Path
+        The files the inputs hash covers (the derivation, ``mechanism.py``, ``codegen.py``).
+    derivation : str, optional
+        Where the derivation is, written as ``DERIVATION`` for the tests that compare the generated code
+        with sympy: a module name (``derivations.mechanisms.planar_2dof``), or a ``.py`` path relative to
+        the generated module (a derivation outside the package, :mod:`derivations.external`).
+    """
     printer = CasadiPrinter({"fully_qualified_modules": True, "inline": True})
     src_names = ", ".join(_relative(p) for p in sorted(sources, key=_relative))
     geo_units = {str(s): mech.geometry_units.get(str(s), "mm") for s in mech.geometry}
@@ -188,7 +205,9 @@ def render(mech, sources) -> str:
     out = [
         f'"""Generated CasADi builders for the mechanism ``{mech.name}``.',
         "",
-        "GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.",
+        "GENERATED -- DO NOT EDIT.  Regenerate with "
+        + (f"``zerocal regen --derivation {derivation}`` (in this directory)." if str(derivation).endswith(".py")
+           else "``zerocal regen``."),
         f"source: {src_names}",
         f"inputs hash: {input_hash(sources)}",
         f"sympy: {sp.__version__}",
@@ -196,6 +215,8 @@ def render(mech, sources) -> str:
         "import casadi as ca",
         "",
         f"NAME = {mech.name!r}",
+        "#: where this module was derived from: a module name, or a .py file relative to this module",
+        f"DERIVATION = {derivation!r}",
         f"DESCRIPTION = {mech.description!r}",
         f"POSE_NAMES = {[str(s) for s in mech.pose]!r}",
         f"JOINT_NAMES = {[str(s) for s in mech.joints]!r}",
@@ -306,7 +327,7 @@ def generate(out_dir: Path | None = None, check_forms: bool = True, derived: dic
     for name, modname in MECHANISMS.items():
         mod = importlib.import_module(modname)
         sources = [HERE / "mechanism.py", HERE / "codegen.py", Path(mod.__file__)]
-        files[out_dir / f"{name}.py"] = render(derived[name], sources)
+        files[out_dir / f"{name}.py"] = render(derived[name], sources, derivation=modname)
     return files
 
 

@@ -14,6 +14,32 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("ZEROCAL_COMPILE", "never")
 
 
+def pytest_addoption(parser):
+    parser.addoption("--contract-robot", action="append", default=[], metavar="ROBOT.toml",
+                     help="also run the mechanism contract suite (tests/test_contract.py) on this robot file's "
+                          "mechanism (repeatable): a mechanism of your own, by its robot file's "
+                          "mechanism_module (docs/new-mechanism.md)")
+
+
+#: the robots of --contract-robot, loaded once when pytest starts: [(path, Robot)]
+CONTRACT_ROBOTS = pytest.StashKey()
+
+
+def pytest_configure(config):
+    """Load the ``--contract-robot`` files before collection: a bad one is a one-line usage error."""
+    paths = config.getoption("contract_robot", default=None) or []
+    robots = []
+    if paths:
+        from zerocal_sym.errors import ZerocalError
+        from zerocal_sym.model.robot import load_robot
+    for path in paths:
+        try:
+            robots.append((path, load_robot(path)))
+        except ZerocalError as exc:
+            raise pytest.UsageError(f"--contract-robot: {exc}") from None
+    config.stash[CONTRACT_ROBOTS] = robots
+
+
 @pytest.fixture(scope="session")
 def robot():
     from zerocal_sym.model.robot import paper_robot
@@ -60,7 +86,7 @@ def pytest_collection_modifyitems(items):
     def rank(item):
         if item.nodeid.endswith(".ipynb") or ".ipynb::" in item.nodeid:
             return 0
-        if {"derived", "generated"} & set(getattr(item, "fixturenames", ())):
+        if {"derived", "generated", "symbolic"} & set(getattr(item, "fixturenames", ())):
             return 1
         return 2
 

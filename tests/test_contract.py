@@ -1,15 +1,28 @@
-"""The mechanism contract, run for every registered mechanism.
+"""The mechanism contract, run for every built-in mechanism and for any other given on the command line.
 
 Each test takes the ``mrobot`` fixture, parametrised over
-:data:`zerocal_sym.model.mechanism.REGISTRY` (the paper's robot; the default
-Delta of examples/delta.toml): a new mechanism is covered by adding its robot
-file to ``ROBOTS``.
+:data:`zerocal_sym.model.mechanism.REGISTRY` (the robots of ``ROBOTS``: the
+paper's robot, the default Delta of examples/delta.toml, ...): a new built-in
+mechanism is covered by adding its robot file to ``ROBOTS``.
+
+A mechanism of one's own (outside the repository: a derivation, its generated
+module, a robot file naming it with ``mechanism_module``) is added to the
+parametrisation by its robot file::
+
+    python -m pytest <checkout>/tests/test_contract.py --contract-robot my_robot.toml -k my_mech
+
+(``--contract-robot`` is defined in tests/conftest.py; repeatable; a robot
+file of a built-in mechanism runs the suite on that geometry).  Its scheme's
+n is the CLI's default (:func:`zerocal_sym.cli._common.default_n`), and the
+tests that compare the generated code with sympy derive the mechanism from
+the file its generated module names (``DERIVATION``).
 """
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from zerocal_sym.cli._common import default_n
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify import identifiability as idf
 from zerocal_sym.identify.nlls import identify_nlls
@@ -34,15 +47,48 @@ def test_every_registered_mechanism_has_a_contract_robot():
     assert set(ROBOTS) == set(REGISTRY)
 
 
-@pytest.fixture(scope="module", params=sorted(REGISTRY))
-def mrobot(request):
-    make, _ = ROBOTS[request.param]
+_CASES = pytest.StashKey()
+
+
+def contract_cases(config) -> dict:
+    """Label -> (robot factory, the boundary scheme's n): every built-in mechanism (``ROBOTS``), then the robot
+    file of each ``--contract-robot`` (labelled by its mechanism, or mechanism-file stem for a second of one;
+    loaded by tests/conftest.py when pytest starts)."""
+    if _CASES not in config.stash:
+        from conftest import CONTRACT_ROBOTS
+
+        cases = {name: ROBOTS[name] for name in sorted(REGISTRY)}
+        for path, robot in config.stash.get(CONTRACT_ROBOTS, []):
+            label = robot.mechanism_name
+            if label in cases:
+                label = f"{label}-{Path(path).stem}"
+            cases[label] = (lambda r=robot: r, default_n(robot))
+        config.stash[_CASES] = cases
+    return config.stash[_CASES]
+
+
+def pytest_generate_tests(metafunc):
+    if "contract_case" in metafunc.fixturenames:
+        cases = list(contract_cases(metafunc.config))
+        metafunc.parametrize("contract_case", cases, ids=cases, scope="module")
+
+
+def test_contract_robot_option_adds_a_case(pytestconfig):
+    """The built-in mechanisms first, each under its name; a --contract-robot file after them."""
+    cases = contract_cases(pytestconfig)
+    assert list(cases)[:len(REGISTRY)] == sorted(REGISTRY)
+    assert len(cases) == len(REGISTRY) + len(pytestconfig.getoption("contract_robot"))
+
+
+@pytest.fixture(scope="module")
+def mrobot(contract_case, request):
+    make, _ = contract_cases(request.config)[contract_case]
     return make()
 
 
 @pytest.fixture(scope="module")
-def scheme(mrobot):
-    return mrobot.workspace.boundary_scheme(ROBOTS[mrobot.mechanism_name][1])
+def scheme(mrobot, contract_case, request):
+    return mrobot.workspace.boundary_scheme(contract_cases(request.config)[contract_case][1])
 
 
 def _inside(robot, rng, N):
@@ -190,11 +236,17 @@ def test_monte_carlo_rms_of_the_zero_offsets_is_the_crlb(mrobot, scheme):
 
 
 @pytest.fixture(scope="module")
-def symbolic(mrobot, derived):
-    """The derivation of the mechanism (sympy; derived once per test process, tests/conftest.py)."""
+def symbolic(mrobot, request):
+    """The derivation of the mechanism (sympy): a built-in one's from the ``derived`` fixture (once per test
+    process, tests/conftest.py); another's from the file (or module) its generated module names
+    (``DERIVATION``, :func:`derivations.external.derivation_of`)."""
     sp = pytest.importorskip("sympy")
+    from derivations import codegen
+    from derivations.external import derivation_of
 
-    return sp, derived[mrobot.mechanism_name]
+    if mrobot.mechanism_name in codegen.MECHANISMS:
+        return sp, request.getfixturevalue("derived")[mrobot.mechanism_name]
+    return sp, derivation_of(mrobot.mechanism.module)
 
 
 def test_generated_functions_match_sympy(mrobot, symbolic, rng):

@@ -78,3 +78,5 @@ def test_generated_header(name):
     assert f"derivations/mechanisms/{name}.py" in head and "derivations/mechanism.py" in head
     assert f"sympy: {sp.__version__}" in head
     assert "inputs hash: " in head
+    # where the contract suite finds the derivation (derivations.external.derivation_of)
+    assert f"\nDERIVATION = 'derivations.mechanisms.{name}'\n" in text

@@ -1,6 +1,10 @@
 """The data files for the rotary Delta (3 joints, xyz poses) and across mechanisms:
 columns from the robot's mechanism, the ``# mechanism:`` line, results with 3
-offsets and 3 MAEMM components, compensation for 3 joints."""
+offsets and 3 MAEMM components, compensation for 3 joints.
+
+Nothing here lists the mechanisms: a file is read as the robot's mechanism,
+the one it names, or the default one, so a new mechanism (built in, or of a
+user's own, tests/test_external_mechanism.py) changes none of these tests."""
 import json
 import re
 from pathlib import Path
@@ -16,12 +20,16 @@ from zerocal_sym.io.poses import load_poses
 from zerocal_sym.io.results import load_result
 from zerocal_sym.model import kinematics
 from zerocal_sym.model.measurements import Measurements
+from zerocal_sym.model.mechanism import known_mechanisms
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.model.robot import load_robot
 
 ROOT = Path(__file__).resolve().parents[1]
 DELTA_HEADER = "pose,theta1_deg,theta2_deg,theta3_deg,reading_mm,x_mm,y_mm,z_mm"
 PLANAR_EXAMPLE = ROOT / "examples" / "measurements_example.csv"
+#: the end of the message for a file that names no mechanism and does not fit the one it is read as
+READ_AS_DEFAULT = (r"; the file names no mechanism and is read as mechanism planar_2dof, the default one \(no robot "
+                   r"file given\): pass the robot file of the measured robot \(--robot\)$")
 
 
 @pytest.fixture(scope="module")
@@ -87,16 +95,19 @@ def test_delta_round_trip(tmp_path, delta, delta_meas):
 
 
 def test_delta_without_mechanism_line_and_targets(tmp_path, delta, delta_meas):
-    """Columns in any order, no targets, no '# mechanism:' line: read as the robot's, or by its columns."""
+    """Columns in any order, no targets, no '# mechanism:' line: read as the robot's mechanism; without a robot
+    as the default one (never guessed from the columns: two mechanisms may share them), and refused so."""
     deg = np.degrees(delta_meas.theta_cmd)
     text = "theta3_deg,reading_mm,theta1_deg,pose,theta2_deg\n" + "".join(
         f"{float(deg[k, 2])!r},{float(delta_meas.readings[k])!r},{float(deg[k, 0])!r},{k},{float(deg[k, 1])!r}\n"
         for k in range(12))
     p = write(tmp_path, text)
-    for robot in (delta, None):
-        m = data.load_measurements(p, robot=robot)
-        assert m.mechanism == "delta_rotary" and m.target is None and m.n is None
-        np.testing.assert_allclose(m.theta_cmd, delta_meas.theta_cmd, rtol=0, atol=1e-15)
+    m = data.load_measurements(p, robot=delta)
+    assert m.mechanism == "delta_rotary" and m.target is None and m.n is None
+    np.testing.assert_allclose(m.theta_cmd, delta_meas.theta_cmd, rtol=0, atol=1e-15)
+    expect_error(lambda: data.load_measurements(p), p, r"^.*:1: unexpected column\(s\): 'theta3_deg' \(column 1; "
+                 r"did you mean 'theta2_deg'\?\); allowed: pose, theta1_deg, theta2_deg, reading_mm, x_mm, y_mm"
+                 + READ_AS_DEFAULT, line=1)
 
 
 def test_delta_file_refused_for_the_planar_robot(tmp_path, robot, delta_meas):
@@ -105,12 +116,14 @@ def test_delta_file_refused_for_the_planar_robot(tmp_path, robot, delta_meas):
     msg = expect_error(lambda: data.load_measurements(p, robot=robot), p,
                        r"measured with mechanism delta_rotary, the robot file is planar_2dof", line=2)
     assert robot.source in msg
-    # without the '# mechanism:' line, the columns say it
+    # without the '# mechanism:' line: read as the robot's mechanism, whose columns these are not
     text = "\n".join(ln for ln in p.read_text().split("\n") if not ln.startswith("# mechanism"))
     q = write(tmp_path, text, "e.csv")
-    expect_error(lambda: data.load_measurements(q, robot=robot), q,
-                 r"the columns are those of mechanism delta_rotary \(theta1_deg, theta2_deg, theta3_deg\), the robot "
-                 r"file is planar_2dof", line=line_of(text, "pose,"))
+    msg = expect_error(lambda: data.load_measurements(q, robot=robot), q,
+                       r"unexpected column\(s\): 'theta3_deg' \(column 4; .*'z_mm' \(column 8; .*; the file names no "
+                       r"mechanism and is read as mechanism planar_2dof, the robot's \(built-in .*\): pass the robot "
+                       r"file of the measured robot \(--robot\)$", line=line_of(text, "pose,"))
+    assert robot.source in msg
 
 
 def test_planar_file_refused_for_the_delta_robot(tmp_path, delta):
@@ -142,12 +155,33 @@ def test_planar_file_without_mechanism_line_still_loads(tmp_path, robot):
         np.testing.assert_array_equal(m.readings, ref.readings)
 
 
+def test_what_a_file_was_read_as_is_said_only_for_a_misfit_of_its_columns(tmp_path, robot):
+    """A header error that is no column mismatch (the separator) says nothing of the mechanism; missing or
+    unexpected columns in a file naming none say what it was read as."""
+    text = "\n".join(ln for ln in PLANAR_EXAMPLE.read_text().split("\n") if not ln.startswith("# mechanism"))
+    hl = line_of(text, "pose,")
+    lines = text.split("\n")
+    lines[hl - 1] = lines[hl - 1].replace(",", ";")
+    p = write(tmp_path, "\n".join(lines), "sep.csv")
+    msg = expect_error(lambda: data.load_measurements(p, robot=robot), p, r"the separator must be a comma", line=hl)
+    assert "names no mechanism" not in msg
+    lines = text.split("\n")
+    lines[hl - 1] = lines[hl - 1].replace("reading_mm", "reading")
+    p = write(tmp_path, "\n".join(lines), "col.csv")
+    expect_error(lambda: data.load_measurements(p, robot=robot), p, r"unexpected column\(s\): 'reading' .*; the file "
+                 r"names no mechanism and is read as mechanism planar_2dof, the robot's", line=hl)
+
+
 def test_unknown_mechanism_line(tmp_path, robot):
-    text = PLANAR_EXAMPLE.read_text().replace("# mechanism: planar_2dof", "# mechanism: hexapod")
+    """The message lists every mechanism known now (built in, installed, registered by a robot file)."""
+    text = PLANAR_EXAMPLE.read_text().replace("# mechanism: planar_2dof", "# mechanism: no_such_mechanism")
     p = write(tmp_path, text)
+    known = ", ".join(known_mechanisms())
+    assert "planar_2dof" in known and "delta_rotary" in known
     for r in (robot, None):
         expect_error(lambda: data.load_measurements(p, robot=r), p,
-                     r"unknown mechanism 'hexapod' \(known: planar_2dof, delta_rotary\)", line=2)
+                     rf"unknown mechanism 'no_such_mechanism' \(known: {re.escape(known)}; a mechanism of your own "
+                     r"is known once its robot file is read: pass --robot\)$", line=2)
 
 
 @pytest.mark.parametrize("edit,pattern", [
@@ -187,7 +221,11 @@ def test_delta_workspace_and_target_checks(tmp_path, delta, delta_meas):
 
 
 def test_delta_template(tmp_path, delta, delta_meas):
-    text = data.format_template(delta_meas.theta_cmd, delta_meas.target, {"robot_sha256": delta.sha256})
+    with pytest.raises(ValueError, match=r"no mechanism named, and the default one, planar_2dof, has 2 joints and 2 "
+                                         r"pose coordinates, not 3 and 3: pass mechanism="):
+        data.format_template(delta_meas.theta_cmd, delta_meas.target, {"robot_sha256": delta.sha256})
+    text = data.format_template(delta_meas.theta_cmd, delta_meas.target, {"robot_sha256": delta.sha256},
+                                mechanism=delta)
     assert "# mechanism: delta_rotary" in text
     p = write(tmp_path, text)
     expect_error(lambda: data.load_measurements(p, robot=delta), p,
@@ -196,12 +234,15 @@ def test_delta_template(tmp_path, delta, delta_meas):
 
 def test_writer_mechanism_checks(delta_meas):
     m = Measurements(delta_meas.theta_cmd, delta_meas.readings, delta_meas.target)
-    assert "# mechanism: delta_rotary" in data.format_measurements(m)  # the only mechanism with 3 joints
+    # no mechanism named: the default one, never one guessed from the sizes (delta_linear has 3 joints too)
+    with pytest.raises(ValueError, match=r"no mechanism named, and the default one, planar_2dof, has 2 joints"):
+        data.format_measurements(m)
+    assert "# mechanism: delta_rotary" in data.format_measurements(m, mechanism="delta_rotary")
     with pytest.raises(ValueError, match=r"theta_cmd must have shape \(K, 2\), got \(12, 3\)"):
         data.format_measurements(m, mechanism="planar_2dof")
     with pytest.raises(ValueError, match=r"conflicting mechanisms"):
         data.format_measurements(delta_meas, mechanism="planar_2dof")
-    with pytest.raises(ValueError, match=r"no single registered mechanism has 4 joints"):
+    with pytest.raises(ValueError, match=r"the default one, planar_2dof, has 2 joints and 2 pose coordinates, not 4: "):
         data.format_measurements(Measurements(np.zeros((3, 4)), np.zeros(3)))
     with pytest.raises(ValueError, match=r"target must have shape \(12, n\)"):
         Measurements(delta_meas.theta_cmd, delta_meas.readings, delta_meas.target[:5])
@@ -221,7 +262,9 @@ def test_measurements_check_robot(robot, delta, delta_meas):
 def test_delta_poses(tmp_path, delta):
     p = write(tmp_path, "# ring\npose,x_mm,y_mm,z_mm\n0,200,0,-700\n1,0,0,-900\n", "p.csv")
     np.testing.assert_array_equal(load_poses(p, delta), [[200, 0, -700], [0, 0, -900]])
-    np.testing.assert_array_equal(load_poses(p), [[200, 0, -700], [0, 0, -900]])  # columns say it
+    # a pose file names no mechanism: without a robot, the default one's columns (never guessed from the columns)
+    expect_error(lambda: load_poses(p), p, r"unexpected column\(s\): 'z_mm' \(column 4.*" + READ_AS_DEFAULT,
+                 line=2)
     p = write(tmp_path, "x_mm,y_mm,z_mm\n200,0,-700\n150,150,-800\n", "p.csv")
     expect_error(lambda: load_poses(p, delta), p,
                  r"pose 1 \(150, 150, -800\) mm is outside the workspace x\^2 \+ y\^2 <= 200\^2", line=3)
@@ -229,7 +272,8 @@ def test_delta_poses(tmp_path, delta):
     expect_error(lambda: load_poses(p, delta), p, r"missing column\(s\): z_mm", line=1)
     p = write(tmp_path, json.dumps({"poses": [[200, 0, -700], [0, 0, -900]]}, indent=1), "d.json")
     np.testing.assert_array_equal(load_poses(p, delta), [[200, 0, -700], [0, 0, -900]])
-    assert load_poses(p).shape == (2, 3)
+    expect_error(lambda: load_poses(p), p, r"key 'poses' must be a non-empty list of \[x_mm, y_mm\] finite numbers"
+                 + READ_AS_DEFAULT, line=2)
     p = write(tmp_path, json.dumps({"poses": [[200, 0, -700], [0, -900]]}, indent=1), "d.json")
     expect_error(lambda: load_poses(p, delta), p,
                  r"key 'poses' must be a non-empty list of \[x_mm, y_mm, z_mm\] finite numbers", line=2)
@@ -259,9 +303,12 @@ def test_delta_result_round_trip(tmp_path, delta):
         assert r.std_zero_offsets_deg[0] == 0.03 and np.isnan(r.std_zero_offsets_deg[1])
         assert r.estimate["rMz"] == -0.5 and np.isnan(r.std["theta2"]) and r.units["theta3"] == "deg"
         assert r.joint_names == ["theta1", "theta2", "theta3"] and r.robot_sha256 == delta.sha256
-    # without a 'mechanism' key: the mechanism with 3 joints
-    p = write(tmp_path, _delta_result(mechanism=None).replace('"mechanism": null,', ""), "s.json")
-    assert "mechanism" not in p.read_text() and load_result(p).mechanism == "delta_rotary"
+    # without a 'mechanism' key: the robot's mechanism; without a robot the default one (not the one with 3 joints)
+    text = _delta_result(mechanism=None).replace('"mechanism": null,', "")
+    p = write(tmp_path, text, "s.json")
+    assert "mechanism" not in p.read_text() and load_result(p, robot=delta).mechanism == "delta_rotary"
+    expect_error(lambda: load_result(p), p, r"key 'zero_offsets_deg' must be a list of 2 numbers \(theta1, theta2\)"
+                 r".*" + READ_AS_DEFAULT, line=line_of(text, '  "zero_offsets_deg"'))
 
 
 def test_delta_result_round_trip_from_identification_result(tmp_path, delta):
@@ -295,7 +342,8 @@ def test_delta_result_round_trip_from_identification_result(tmp_path, delta):
     ({"std_zero_offsets_deg": [0.1, 0.1]}, None, r"key 'std_zero_offsets_deg' must be a list of 3 numbers",
      "std_zero_offsets_deg"),
     ({}, "planar", r"identified with mechanism delta_rotary, the robot file is planar_2dof", "mechanism"),
-    ({"mechanism": "hexapod"}, None, r"unknown mechanism \"hexapod\"", "mechanism"),
+    ({"mechanism": "no_such_mechanism"}, None, r"key 'mechanism': unknown mechanism 'no_such_mechanism' \(known: "
+     r"planar_2dof, .*; a mechanism of your own is known once its robot file is read: pass --robot\)", "mechanism"),
     ({"estimate": {"theta1": 2.0, "e1x": 0.1}}, None, r"key 'estimate': unknown parameter 'e1x' of mechanism "
      r"delta_rotary", "estimate"),
     ({"units": {"theta1": "rad"}}, None, r"the unit of 'theta1' must be \"deg\", got \"rad\"", "units"),
@@ -332,7 +380,10 @@ def test_delta_compensation(tmp_path, delta, delta_err):
     with pytest.raises(ValueError, match=r"expected 3 zero offsets"):
         compensated_commands(delta, P, [1.0, 2.0])
     # the compensated commands table
-    text = format_commands(P, nominal, cmd, off, {"robot_sha256": delta.sha256})
+    with pytest.raises(ValueError, match=r"mechanism planar_2dof has 2 joints and 2 pose coordinates, got 3 and 3 "
+                                         r"\(none named: the default one; pass mechanism=\)"):
+        format_commands(P, nominal, cmd, off, {"robot_sha256": delta.sha256})
+    text = format_commands(P, nominal, cmd, off, {"robot_sha256": delta.sha256}, mechanism=delta)
     rows = [ln.split(",") for ln in text.splitlines() if not ln.startswith("#")]
     assert rows[0] == ["pose", "x_mm", "y_mm", "z_mm", "theta1_nominal_deg", "theta2_nominal_deg",
                        "theta3_nominal_deg", "theta1_cmd_deg", "theta2_cmd_deg", "theta3_cmd_deg"]

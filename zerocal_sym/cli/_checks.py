@@ -18,7 +18,8 @@ The rules:
   ``compensate --max-offset-deg`` without a result, its ``--endstop-mm
   --homed-height-mm`` with the csv table and its poses with a controller
   format; ``--report`` with
-  ``--json`` (the JSON holds the report); ``regen``/``study --robot``.
+  ``--json`` (the JSON holds the report); ``regen``/``study --robot``;
+  ``regen --out`` without ``--derivation`` and ``--out-dir`` with it.
 * **Numbers**: seeds are integers >= 0; counts in their range (``--n`` at most
   :data:`MAX_N` poses per boundary); thresholds finite and positive.
 * **Files**, first, for every command alike: the options declare what they
@@ -289,7 +290,13 @@ def _reproduce(args) -> None:
 def _regen(args) -> None:
     if _given(args, "robot"):
         raise ZerocalError("--robot: regen reads no robot file (it regenerates the code of every mechanism "
-                           "from derivations/)")
+                           "from derivations/, or of one derivation file with --derivation)")
+    if _given(args, "out") and not _given(args, "derivation"):
+        raise ZerocalError("--out names the generated module of a --derivation file: without one, regen writes "
+                           "every built-in mechanism (--out-dir DIR for another directory)")
+    if _given(args, "out_dir") and _given(args, "derivation"):
+        raise ZerocalError("--out-dir is for the built-in mechanisms: a --derivation file's generated module is "
+                           "chosen with --out FILE.py (default: beside the derivation)")
 
 
 def _study(args) -> None:

@@ -2,12 +2,14 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_linear.py
-inputs hash: 7c9603421cd3db54
+inputs hash: 059e8ea540e425c4
 sympy: 1.14.0
 """
 import casadi as ca
 
 NAME = 'delta_linear'
+#: where this module was derived from: a module name, or a .py file relative to this module
+DERIVATION = 'derivations.mechanisms.delta_linear'
 DESCRIPTION = 'linear Delta robot (three prismatic towers, parallel rods) with a spherical-joint measuring mechanism'
 POSE_NAMES = ['x', 'y', 'z']
 JOINT_NAMES = ['s1', 's2', 's3']

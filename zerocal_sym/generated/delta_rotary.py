@@ -2,12 +2,14 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 54452a63d5c48cf5
+inputs hash: 0e5f4cce76292619
 sympy: 1.14.0
 """
 import casadi as ca
 
 NAME = 'delta_rotary'
+#: where this module was derived from: a module name, or a .py file relative to this module
+DERIVATION = 'derivations.mechanisms.delta_rotary'
 DESCRIPTION = 'rotary Delta robot (three RSS limbs, parallelogram forearms) with a spherical-joint measuring mechanism'
 POSE_NAMES = ['x', 'y', 'z']
 JOINT_NAMES = ['theta1', 'theta2', 'theta3']

@@ -2,12 +2,14 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/hexapod.py
-inputs hash: 1720fd67ae42df52
+inputs hash: 42cb3a18875a2a15
 sympy: 1.14.0
 """
 import casadi as ca
 
 NAME = 'hexapod'
+#: where this module was derived from: a module name, or a .py file relative to this module
+DERIVATION = 'derivations.mechanisms.hexapod'
 DESCRIPTION = '6-6 Gough-Stewart hexapod (six prismatic legs) with a spherical-joint measuring mechanism'
 POSE_NAMES = ['x', 'y', 'z', 'roll', 'pitch', 'yaw']
 JOINT_NAMES = ['L1', 'L2', 'L3', 'L4', 'L5', 'L6']

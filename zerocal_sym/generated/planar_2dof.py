@@ -2,12 +2,14 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: 70802b43d71d2259
+inputs hash: e79edf08cebe6b46
 sympy: 1.14.0
 """
 import casadi as ca
 
 NAME = 'planar_2dof'
+#: where this module was derived from: a module name, or a .py file relative to this module
+DERIVATION = 'derivations.mechanisms.planar_2dof'
 DESCRIPTION = '2-DOF translational parallel robot of Mei et al. 2017 (two RR limbs, planar)'
 POSE_NAMES = ['x', 'y']
 JOINT_NAMES = ['theta1', 'theta2']

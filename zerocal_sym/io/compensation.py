@@ -19,7 +19,7 @@ import re
 
 import numpy as np
 
-from zerocal_sym.io.csvtext import MECHANISM_KEY, _format_meta, get_mechanism_of, mechanism_for_shape
+from zerocal_sym.io.csvtext import MECHANISM_KEY, _format_meta, get_mechanism_of
 from zerocal_sym.io.results import SIGN_CONVENTION, ResultFile, sign_convention  # noqa: F401 (SIGN_CONVENTION)
 from zerocal_sym.model import units
 
@@ -91,12 +91,13 @@ def compensated_commands(robot, P, offsets_user) -> tuple[np.ndarray, np.ndarray
     return nominal, nominal - units.joints_from_user(robot, off)
 
 
-def _mechanism(mechanism, m, n=None, declared=None):
-    """The Mechanism named (or of the robot), else the only one with these sizes, else None."""
+def _mechanism(mechanism, declared=None):
+    """The Mechanism named (or of the robot), else the declared one, else the default one (never guessed from
+    the sizes); and whether one was named."""
     for spec in (mechanism, declared):
         if spec is not None:
-            return get_mechanism_of(spec)
-    return mechanism_for_shape(m, n)
+            return get_mechanism_of(spec), True
+    return get_mechanism_of(None), False
 
 
 def format_compensation(result: ResultFile, meta: dict | None = None, mechanism=None) -> str:
@@ -116,14 +117,15 @@ def format_compensation(result: ResultFile, meta: dict | None = None, mechanism=
         convention (and the mechanism).
     """
     m = len(result.zero_offsets_user)
-    mech = _mechanism(mechanism, m, declared=result.mechanism)
-    joints = list(mech.joint_names) if mech is not None else [f"theta{j + 1}" for j in range(m)]
+    mech, named = _mechanism(mechanism, declared=result.mechanism)
+    joints = list(mech.joint_names)
     if len(joints) != m:
-        raise ValueError(f"{m} zero offsets for the {len(joints)} joints of mechanism {mech.name}")
+        raise ValueError(f"{m} zero offsets for the {len(joints)} joints of mechanism {mech.name}"
+                         + ("" if named else " (none named: the default one; pass mechanism=)"))
     u = result.offset_unit
     buf = io.StringIO()
     buf.write(COMPENSATION_LINE + "\n")
-    buf.write(_format_meta({"sign": sign_convention(u), **({MECHANISM_KEY: mech.name} if mech else {}),
+    buf.write(_format_meta({"sign": sign_convention(u), MECHANISM_KEY: mech.name,
                            "method": result.method, "status": result.status,
                            **({"robot_sha256": result.robot_sha256} if result.robot_sha256 else {}),
                            **(meta or {})}))
@@ -158,8 +160,7 @@ def format_commands(P, theta_nominal, theta_cmd, offsets_deg, meta: dict | None 
     offsets_deg : (m,)
     meta : dict, optional
     mechanism : str, Mechanism or Robot, optional
-        For the column names; default the registered mechanism with these
-        sizes.
+        For the column names; default the default mechanism.
 
     Returns
     -------
@@ -180,11 +181,10 @@ def format_commands(P, theta_nominal, theta_cmd, offsets_deg, meta: dict | None 
     if nom.shape != (K, m) or cmd.shape != (K, m):
         raise ValueError(f"theta_nominal and theta_cmd must have shape ({K}, m), got {nom.shape} and {cmd.shape}")
     off = _offsets(offsets_deg, m)
-    mech = _mechanism(mechanism, m, n)
-    if mech is None:
-        raise ValueError(f"no single registered mechanism has {m} joints and {n} pose coordinates: pass mechanism=")
+    mech, named = _mechanism(mechanism)
     if (mech.m, mech.n) != (m, n):
-        raise ValueError(f"mechanism {mech.name} has {mech.m} joints and {mech.n} pose coordinates, got {m} and {n}")
+        raise ValueError(f"mechanism {mech.name} has {mech.m} joints and {mech.n} pose coordinates, got {m} and {n}"
+                         + ("" if named else " (none named: the default one; pass mechanism=)"))
     u = mech.joint_user_unit
     nom, cmd, P = units.joints_to_user(mech, nom), units.joints_to_user(mech, cmd), units.pose_to_user(mech, P)
     buf = io.StringIO()

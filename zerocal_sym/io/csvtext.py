@@ -12,9 +12,11 @@ where there is one, the column (by name and field number).
 The columns of the data files come from the robot's mechanism
 (:func:`joint_columns`, :func:`pose_columns`): ``theta1_deg, theta2_deg[,
 theta3_deg]`` from its joint names, ``x_mm, y_mm[, z_mm]`` from its pose
-names.  A file read without a robot is matched to the registered mechanism
-whose columns it has (:func:`infer_mechanism`), the default mechanism if none
-fits (so the messages name the columns a planar file needs).
+names.  A file is read as the mechanism of the robot it is read for, else
+as the one it names (``# mechanism:``, a results file's ``mechanism``), else
+as the default mechanism (:func:`read_as`); it is never matched to a
+mechanism by its columns or sizes (two mechanisms may share them), and
+columns that do not fit are an error that says what the file was read as.
 """
 from __future__ import annotations
 
@@ -26,6 +28,11 @@ import re
 from pathlib import Path
 
 from zerocal_sym.errors import DataFileError
+
+class ColumnMismatch(DataFileError):
+    """A header whose columns are not the expected ones (unexpected or missing columns): maybe another
+    mechanism's, so a reader says which mechanism it read the file as (:func:`with_reading_hint`)."""
+
 
 #: metadata key naming the mechanism a file belongs to (``# mechanism: delta_rotary``)
 MECHANISM_KEY = "mechanism"
@@ -143,11 +150,11 @@ def _check_header(header, header_line, src, allowed, required, example):
             hints.append(f"'{c}' (column {header.index(c) + 1}" + (f"; did you mean '{close[0]}'?)" if close else ")"))
         missing = [c for c in required if c not in header]
         miss = f"; missing: {', '.join(missing)}" if missing else ""
-        raise DataFileError(f"unexpected column(s): {', '.join(hints)}{miss}; allowed: {', '.join(allowed)}",
-                            where=where)
+        raise ColumnMismatch(f"unexpected column(s): {', '.join(hints)}{miss}; allowed: {', '.join(allowed)}",
+                             where=where)
     missing = [c for c in required if c not in header]
     if missing:
-        raise DataFileError(f"missing column(s): {', '.join(missing)} (header must be {example})", where=where)
+        raise ColumnMismatch(f"missing column(s): {', '.join(missing)} (header must be {example})", where=where)
 
 
 def _number(text: str, where: str, col: str, j: int) -> float:
@@ -267,15 +274,16 @@ def get_mechanism_of(spec=None):
     Parameters
     ----------
     spec : str, Mechanism, Robot or None
-        A registered name, a mechanism, a robot (its mechanism), or None for
-        the default mechanism.
+        A known mechanism's name (:func:`~zerocal_sym.model.mechanism.known_mechanisms`: the built-in ones,
+        installed packages' and those a robot file registered), a mechanism, a robot (its mechanism), or
+        None for the default mechanism.
 
     Raises
     ------
     ValueError
         An unknown mechanism name.
     """
-    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, REGISTRY, Mechanism, get_mechanism
+    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, Mechanism, get_mechanism, is_known
 
     if spec is None:
         return get_mechanism(DEFAULT_MECHANISM)
@@ -283,16 +291,22 @@ def get_mechanism_of(spec=None):
         return spec
     if not isinstance(spec, str):
         return spec.mechanism
-    if spec not in REGISTRY:
-        raise ValueError(f"unknown mechanism {spec!r} (known: {', '.join(REGISTRY)})")
+    if not is_known(spec):
+        raise ValueError(f"unknown mechanism {spec!r} (known: {', '.join(known_names())})")
     return get_mechanism(spec)
 
 
-def registered_mechanisms() -> list:
-    """Every registered mechanism, the default first."""
-    from zerocal_sym.model.mechanism import DEFAULT_MECHANISM, REGISTRY, get_mechanism
+def known_names() -> list:
+    """The names of the mechanisms known now (built in, installed, registered by a robot file)."""
+    from zerocal_sym.model.mechanism import known_mechanisms
 
-    return [get_mechanism(k) for k in sorted(REGISTRY, key=lambda k: k != DEFAULT_MECHANISM)]
+    return list(known_mechanisms())
+
+
+def unknown_mechanism_message(name) -> str:
+    """``unknown mechanism 'x' (known: ...)``, with how a mechanism of one's own becomes known."""
+    return (f"unknown mechanism {name!r} (known: {', '.join(known_names())}; a mechanism of your own is known "
+            "once its robot file is read: pass --robot)")
 
 
 def joint_columns(mech, suffix: str | None = None) -> tuple:
@@ -312,40 +326,25 @@ def pose_columns(mech) -> tuple:
     return tuple(f"{p}_{pose_unit(mech, p)}" for p in mech.pose_names)
 
 
-def infer_mechanism(header, joints: bool = True):
-    """The registered mechanism whose columns ``header`` has, else the default.
+def read_as(robot, declared=None) -> tuple:
+    """The mechanism a file is read as, and why (for messages): ``(Mechanism, reason)``.
 
-    Parameters
-    ----------
-    header : sequence of str
-    joints : bool
-        Match the joint columns first (measurement files), then the pose
-        columns; with False only the pose columns (pose lists).
-
-    Returns
-    -------
-    Mechanism
+    The robot's mechanism if there is a robot, else the one the file declares, else the default
+    mechanism.  A file is never matched to a mechanism by its columns or its sizes: two mechanisms may
+    have the same ones.
     """
-    mechs = registered_mechanisms()
-    h = set(header)
-    cands = mechs
-    for cols_of in ((joint_columns, pose_columns) if joints else (pose_columns,)):
-        present = h & set().union(*(cols_of(x) for x in mechs))
-        fit = [x for x in cands if set(cols_of(x)) == present]
-        if not fit and cols_of is pose_columns and not present:
-            fit = cands  # targets are optional
-        if not fit:
-            break
-        cands = fit
-        if len(cands) == 1:
-            break
-    return cands[0]
+    if robot is not None:
+        return robot.mechanism, f"the robot's ({robot.source})"
+    if declared is not None:
+        return get_mechanism_of(declared), "the one it names"
+    return get_mechanism_of(None), "the default one (no robot file given)"
 
 
-def mechanism_for_shape(m: int | None = None, n: int | None = None):
-    """The one registered mechanism with m joints and n pose coordinates (None: any), or None."""
-    fit = [x for x in registered_mechanisms() if (m is None or x.m == m) and (n is None or x.n == n)]
-    return fit[0] if len(fit) == 1 else None
+def with_reading_hint(exc: DataFileError, mech, reason: str) -> DataFileError:
+    """``exc`` with what the file was read as appended (a file without a mechanism line whose columns or
+    sizes do not fit): one line, the same place."""
+    return DataFileError(f"{exc.message}; the file names no mechanism and is read as mechanism {mech.name}, "
+                         f"{reason}: pass the robot file of the measured robot (--robot)", where=exc.where)
 
 
 def _go_together(names) -> str:

@@ -1,7 +1,7 @@
 """Checks of a measurement file beyond its syntax: its mechanism, repeated poses, the robot.
 
-* :func:`_declared_mechanism`, :func:`_check_columns_fit_robot` -- the
-  ``# mechanism:`` line and the columns against the robot's mechanism;
+* :func:`_declared_mechanism` -- the ``# mechanism:`` line: a known
+  mechanism, the robot's;
 * :func:`_check_metadata` -- the ``# robot_sha256:`` line is a SHA-256 (64
   hexadecimal digits), the ``# compensation_deg:`` line one finite angle per
   joint;
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import MECHANISM_KEY, infer_mechanism
+from zerocal_sym.io.csvtext import MECHANISM_KEY, unknown_mechanism_message
 from zerocal_sym.io.duplicates import first_duplicate
 from zerocal_sym.io.measurement_columns import MeasurementColumns, measurement_columns
 from zerocal_sym.model import units
@@ -56,40 +56,26 @@ def _check_metadata(meta, meta_lines, src, mech) -> None:
 
 def _declared_mechanism(meta, meta_lines, src, robot):
     """The file's ``# mechanism:`` (None without); unknown or not the robot's: DataFileError."""
-    from zerocal_sym.model.mechanism import known_mechanisms
+    from zerocal_sym.model.mechanism import is_known
 
     declared = meta.get(MECHANISM_KEY)
     if declared is None:
         return None
     where = f"{src}:{meta_lines[MECHANISM_KEY]}"
-    known = known_mechanisms()
-    if declared not in known and (robot is None or declared != robot.mechanism_name):
-        raise DataFileError(f"unknown mechanism {declared!r} (known: {', '.join(known)})", where=where)
+    if not is_known(declared):
+        raise DataFileError(unknown_mechanism_message(declared), where=where)
     if robot is not None and declared != robot.mechanism_name:
         raise DataFileError(f"measured with mechanism {declared}, the robot file is {robot.mechanism_name} "
                             f"({robot.source}): pass the robot file of the measured robot", where=where)
     return declared
 
 
-def _check_columns_fit_robot(header, where, robot) -> None:
-    """A file without ``# mechanism:`` whose columns are exactly another mechanism's: DataFileError."""
-    other = infer_mechanism(header)
-    if other.name == robot.mechanism_name:
-        return
-    cols = measurement_columns(other)
-    h = set(header)
-    if set(cols.required) <= h and h - set(cols.required) in (set(), set(cols.pose)):
-        raise DataFileError(f"the columns are those of mechanism {other.name} ({', '.join(cols.joints)}), "
-                            f"the robot file is {robot.mechanism_name} ({robot.source}): pass the robot file of "
-                            "the measured robot", where=where)
-
-
 def _joint_unit(meas) -> str:
     """Internal unit of the measured joints (the file's mechanism's; rad when it names none)."""
-    from zerocal_sym.model.mechanism import get_mechanism, known_mechanisms
+    from zerocal_sym.model.mechanism import get_mechanism, is_known
 
     name = meas.mechanism
-    return get_mechanism(name).joint_unit if name in known_mechanisms() else "rad"
+    return get_mechanism(name).joint_unit if name is not None and is_known(name) else "rad"
 
 
 def _check_duplicates(meas: Measurements, cols: MeasurementColumns) -> None:

@@ -24,8 +24,9 @@ columns come from the robot's mechanism (here the planar robot's)::
   or none): the nominal target position.
 * ``# mechanism: NAME``: the mechanism measured.  A file without it is read as
   the mechanism of the robot it is checked against, or (no robot) as the
-  registered mechanism whose columns it has; a file naming another mechanism
-  than the robot's is refused.
+  default mechanism -- never guessed from its columns -- and columns that do
+  not fit are an error saying so; a file naming another mechanism than the
+  robot's is refused.
 
 Columns may come in any order; the separator is a comma; ``#`` starts a
 comment line; blank lines are ignored; a UTF-8 byte-order mark is accepted.
@@ -53,12 +54,12 @@ import numpy as np
 from zerocal_sym.model import units
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (MECHANISM_KEY, _check_header, _check_pose_numbers, _format_meta, _go_together,
-                                    _read_text, _rows_to_array, _split_csv, get_mechanism_of, infer_mechanism,
-                                    mechanism_for_shape)
+from zerocal_sym.io.csvtext import (MECHANISM_KEY, ColumnMismatch, _check_header, _check_pose_numbers, _format_meta,
+                                    _go_together, _read_text, _rows_to_array, _split_csv, get_mechanism_of, read_as,
+                                    with_reading_hint)
 from zerocal_sym.io.files import atomic_write_text
-from zerocal_sym.io.measurement_checks import (_check_columns_fit_robot, _check_duplicates, _check_metadata,
-                                               _declared_mechanism, check_against_robot)
+from zerocal_sym.io.measurement_checks import (_check_duplicates, _check_metadata, _declared_mechanism,
+                                               check_against_robot)
 from zerocal_sym.io.measurement_columns import measurement_columns
 from zerocal_sym.model.measurements import Measurements, _check_arrays
 
@@ -79,7 +80,7 @@ def __getattr__(name):
 # --------------------------------------------------------------------------- writing
 
 def resolve_mechanism(theta_cmd, target=None, meta=None, mechanism=None, declared=None):
-    """The mechanism a writer names: given, declared, or the only one with these shapes.
+    """The mechanism a writer names: given, declared, or the default one (never guessed from the shapes).
 
     Parameters
     ----------
@@ -98,23 +99,20 @@ def resolve_mechanism(theta_cmd, target=None, meta=None, mechanism=None, declare
     Raises
     ------
     ValueError
-        Conflicting names, an unknown one, shapes that do not fit it, or (none
-        named) not exactly one registered mechanism with these shapes.
+        Conflicting names, an unknown one, or shapes that do not fit the
+        mechanism (none named: the default one).
     """
     theta_cmd, _, target = _check_arrays(theta_cmd, None, target)
     named = [get_mechanism_of(x).name for x in (mechanism, declared, (meta or {}).get(MECHANISM_KEY))
              if x is not None]
     if len(set(named)) > 1:
         raise ValueError(f"conflicting mechanisms: {', '.join(dict.fromkeys(named))}")
+    mech = get_mechanism_of(named[0] if named else None)
     m, n = theta_cmd.shape[1], None if target is None else target.shape[1]
-    if named:
-        mech = get_mechanism_of(named[0])
-        _check_arrays(theta_cmd, None, target, mech.m, mech.n)
-        return mech
-    mech = mechanism_for_shape(m, n)
-    if mech is None:
-        raise ValueError(f"no single registered mechanism has {m} joints" +
-                         ("" if n is None else f" and {n} pose coordinates") + ": pass mechanism=")
+    if not named and (m != mech.m or n not in (None, mech.n)):
+        raise ValueError(f"no mechanism named, and the default one, {mech.name}, has {mech.m} joints and {mech.n} "
+                         f"pose coordinates, not {m}" + ("" if n is None else f" and {n}") + ": pass mechanism=")
+    _check_arrays(theta_cmd, None, target, mech.m, mech.n)
     return mech
 
 
@@ -146,8 +144,8 @@ def format_measurements(meas: Measurements, mechanism=None) -> str:
     meas : Measurements
     mechanism : str, Mechanism or Robot, optional
         The mechanism to name in the ``# mechanism:`` line; default
-        ``meas.mechanism``, ``meas.meta["mechanism"]``, or the registered
-        mechanism with ``meas``'s shapes (see :func:`resolve_mechanism`).
+        ``meas.mechanism``, ``meas.meta["mechanism"]``, or the default
+        mechanism (see :func:`resolve_mechanism`).
 
     Raises
     ------
@@ -175,7 +173,7 @@ def format_template(theta_cmd, target=None, meta=None, mechanism=None) -> str:
         Nominal target positions, mm.
     meta : dict, optional
     mechanism : str, Mechanism or Robot, optional
-        Default: the registered mechanism with these shapes.
+        Default: the default mechanism (:func:`resolve_mechanism`).
 
     Returns
     -------
@@ -206,8 +204,8 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
         within :data:`~zerocal_sym.io.measurement_checks.TARGET_TOL_MM` of
         where the commanded angles lead; a
         ``robot_sha256`` metadata line must match the robot.  Without a
-        robot, the columns are those of the mechanism the file names, or of
-        the registered mechanism whose columns the header has.
+        robot, the columns are those of the mechanism the file names, or
+        (none named) of the default mechanism.
     min_poses : int
         At least this many poses (5 for the paper's 4 parameters).
 
@@ -225,21 +223,25 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     text, src = _read_text(path)
     meta, meta_lines, rows = _split_csv(text, src, "# zerocal measurements", FORMAT_VERSION)
     declared = _declared_mechanism(meta, meta_lines, src, robot)
-    if robot is not None:
-        mech = robot.mechanism
-    elif declared is not None:
-        mech = get_mechanism_of(declared)
-    else:
-        mech = infer_mechanism(rows[0][1]) if rows else get_mechanism_of(None)
-    _check_metadata(meta, meta_lines, src, mech)
+    mech, reason = read_as(robot, declared)
+
+    def fits(check, *args, errors=DataFileError):
+        """``check(*args)``; a file naming no mechanism is told what it was read as when it does not fit (its
+        columns or its per-joint metadata may be another mechanism's)."""
+        try:
+            check(*args)
+        except errors as exc:
+            if declared is None:
+                raise with_reading_hint(exc, mech, reason) from None
+            raise
+
+    fits(_check_metadata, meta, meta_lines, src, mech)
     cols = measurement_columns(mech)
     if not rows:
         raise DataFileError(f"empty file: no header line and no data (expected the header {cols.example})",
                             where=src)
     header_line, header = rows[0]
-    if robot is not None and declared is None:
-        _check_columns_fit_robot(header, f"{src}:{header_line}", robot)
-    _check_header(header, header_line, src, cols.allowed, cols.required, cols.example)
+    fits(_check_header, header, header_line, src, cols.allowed, cols.required, cols.example, errors=ColumnMismatch)
     has_pose = [c in header for c in cols.pose]
     if any(has_pose) and not all(has_pose):
         raise DataFileError(_go_together(cols.pose), where=f"{src}:{header_line}")

@@ -5,10 +5,10 @@ Pose file
 A list of target positions, one coordinate column per pose coordinate of the
 robot's mechanism (``pose`` optional, ``x_mm``, ``y_mm``[, ``z_mm``]), or a
 JSON object whose ``poses`` is a list of ``[x, y(, z)]``; read by
-:func:`load_poses` (for ``zerocal compensate --poses``).  Without a robot, the
-columns are those of the registered mechanism they fit (the default
-mechanism's if none), and a JSON list is taken as it comes (every pose with
-the same number of coordinates, that of a registered mechanism).
+:func:`load_poses` (for ``zerocal compensate --poses``).  The columns (the length of each JSON
+pose) are those of the robot's mechanism, or without a robot those of the
+default mechanism: a pose file names no mechanism, and is not matched to one
+by its columns.
 """
 from __future__ import annotations
 
@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, _check_header, _check_pose_numbers, _json_line, _load_json,
-                                    _read_text, _rows_to_array, _split_csv, get_mechanism_of, infer_mechanism,
-                                    mechanism_for_shape, pose_columns)
+from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, ColumnMismatch, _check_header, _check_pose_numbers, _json_line,
+                                    _load_json, _read_text, _rows_to_array, _split_csv, pose_columns, read_as,
+                                    with_reading_hint)
 
 
 def __getattr__(name):
@@ -46,7 +46,8 @@ def load_poses(path, robot=None) -> np.ndarray:
     path : str or Path
     robot : Robot, optional
         If given: the columns (and the length of each JSON pose) are its
-        mechanism's, and every pose must lie in its workspace (1e-6 mm).
+        mechanism's, and every pose must lie in its workspace (1e-6 mm);
+        without: the default mechanism's.
 
     Returns
     -------
@@ -57,18 +58,14 @@ def load_poses(path, robot=None) -> np.ndarray:
     ------
     DataFileError
     """
+    text, src = _read_text(path, "pose file")
     from zerocal_sym.model.kinematics import fmt_pose
 
-    text, src = _read_text(path, "pose file")
+    mech, reason = read_as(robot)
+    cols = pose_columns(mech)
     if text.lstrip().startswith("{"):
         obj = _load_json(text, src)
         v = obj.get("poses") if isinstance(obj, dict) else None
-        if robot is not None:
-            mech = robot.mechanism
-        else:
-            first = len(v[0]) if isinstance(v, list) and v and isinstance(v[0], list) else None
-            mech = mechanism_for_shape(n=first) or get_mechanism_of(None)
-        cols = pose_columns(mech)
         example = "[" + ", ".join(cols) + "]"
         if not isinstance(obj, dict) or "poses" not in obj:
             raise DataFileError(f"a JSON pose file needs a key 'poses' (list of {example})", where=src)
@@ -76,19 +73,23 @@ def load_poses(path, robot=None) -> np.ndarray:
         ok = isinstance(v, list) and len(v) > 0 and all(
             isinstance(p, list) and len(p) == len(cols) and all(_is_number(x) for x in p) for p in v)
         if not ok:
-            raise DataFileError(f"key 'poses' must be a non-empty list of {example} finite numbers", where=where)
+            exc = DataFileError(f"key 'poses' must be a non-empty list of {example} finite numbers", where=where)
+            if isinstance(v, list) and any(isinstance(p, list) and len(p) != len(cols) for p in v):
+                raise with_reading_hint(exc, mech, reason)  # poses of another size: another mechanism's?
+            raise exc
         P = np.array(v, float)
         lines = None
     else:
         _, _, rows = _split_csv(text, src)
-        mech = robot.mechanism if robot is not None else infer_mechanism(rows[0][1] if rows else (), joints=False)
-        cols = pose_columns(mech)
         example = "[pose,]" + ",".join(cols)
         if not rows:
             raise DataFileError(f"empty file: no header line and no data (expected the header {example})",
                                 where=src)
         header_line, header = rows[0]
-        _check_header(header, header_line, src, ("pose",) + cols, cols, example)
+        try:
+            _check_header(header, header_line, src, ("pose",) + cols, cols, example)
+        except ColumnMismatch as exc:
+            raise with_reading_hint(exc, mech, reason) from None  # another mechanism's columns?
         if len(rows) == 1:
             raise DataFileError("no data rows after the header", where=f"{src}:{header_line}")
         V, lines = _rows_to_array(rows[1:], header, src)

@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import _json_line, _load_json, _read_text, get_mechanism_of, mechanism_for_shape
+from zerocal_sym.io.csvtext import (_json_line, _load_json, _read_text, get_mechanism_of, read_as,
+                                    unknown_mechanism_message, with_reading_hint)
 
 #: the unit of the zero offsets at the file edge of a revolute mechanism (a prismatic one's: mm); every key that
 #: names them is made from the unit here (:func:`offset_keys`)
@@ -82,9 +83,9 @@ class ResultFile:
         The whole JSON object.
     source : str
     mechanism : str or None
-        The mechanism: the file's ``mechanism`` key, else the robot's it was
-        loaded for, else the registered mechanism with m joints (None if
-        that is not unique).
+        The mechanism: the robot's it was loaded for, else the file's
+        ``mechanism`` key, else the default mechanism (None only for a
+        ResultFile made otherwise than by :func:`load_result`).
     estimate, std : dict of str -> float
         Every identified parameter by name, user units (``units``); NaN for
         an unknown standard deviation.  Empty if the file has none.
@@ -213,14 +214,15 @@ def _find_sha(obj, text, src):
 
 def _find_mechanism(obj, text, src):
     """The ``mechanism`` key (and ``robot.mechanism``, which must agree), checked; None without."""
-    from zerocal_sym.model.mechanism import known_mechanisms
+    from zerocal_sym.model.mechanism import is_known
 
     known = known_mechanisms()
     named = [(k, v) for k, v in (("mechanism", obj.get("mechanism")),
                                  ("robot.mechanism", _robot_block(obj, text, src).get("mechanism"))) if v is not None]
     for k, v in named:
-        if not isinstance(v, str) or v not in known:
-            raise DataFileError(f"key '{k}': unknown mechanism {json.dumps(v)[:60]} (known: {', '.join(known)})",
+        if not isinstance(v, str) or not is_known(v):
+            raise DataFileError(f"key '{k}': " + unknown_mechanism_message(v if isinstance(v, str) else
+                                                                         json.dumps(v)[:60]),
                                 where=_where(text, "mechanism", src))
     if len(named) == 2 and named[0][1] != named[1][1]:
         raise DataFileError(f"key 'mechanism' is {named[0][1]}, 'robot.mechanism' is {named[1][1]}: one result is of "
@@ -328,9 +330,9 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     robot : Robot, optional
         If given: a ``mechanism`` key must name the robot's mechanism, and
         the vectors have its m joints and n pose coordinates.  Without one,
-        the mechanism is the file's ``mechanism``, or the registered one with
-        ``len(zero_offsets_deg)`` joints (the default mechanism's sizes are
-        expected if there is none).
+        the mechanism is the file's ``mechanism``, or (none named) the
+        default mechanism: never guessed from the sizes, and sizes that do
+        not fit are an error saying what the file was read as.
 
     Returns
     -------
@@ -348,24 +350,27 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     if not isinstance(obj, dict):
         raise DataFileError("a results file is a JSON object {...}", where=src)
     declared = _find_mechanism(obj, text, src)
-    if robot is not None:
-        if declared is not None and declared != robot.mechanism_name:
-            raise DataFileError(f"identified with mechanism {declared}, the robot file is {robot.mechanism_name} "
-                                f"({robot.source}): pass the robot file of the identified robot",
-                                where=_where(text, "mechanism", src))
-        mech = robot.mechanism
-    elif declared is not None:
-        mech = get_mechanism_of(declared)
-    else:
-        off = obj.get(OFFSETS_KEY)
-        mech = mechanism_for_shape(m=len(off)) if isinstance(off, list) else None
-    shape_of = mech or get_mechanism_of(None)  # the sizes expected when the mechanism is unknown
-    names, measuring = shape_of.errors.zero_offsets, shape_of.errors.measuring
-    unit = shape_of.errors.offset_user_unit
+    if robot is not None and declared is not None and declared != robot.mechanism_name:
+        raise DataFileError(f"identified with mechanism {declared}, the robot file is {robot.mechanism_name} "
+                            f"({robot.source}): pass the robot file of the identified robot",
+                            where=_where(text, "mechanism", src))
+    mech, reason = read_as(robot, declared)
+
+    def fits(read, *args, **kw):
+        """``read(*args)``; a file naming no mechanism is told what it was read as when it does not fit."""
+        try:
+            return read(*args, **kw)
+        except DataFileError as exc:
+            if declared is None:
+                raise with_reading_hint(exc, mech, reason) from None
+            raise
+
+    names, measuring = mech.errors.zero_offsets, mech.errors.measuring
+    unit = mech.errors.offset_user_unit
     offsets_key, std_offsets_key, _ = offset_keys(unit)
-    off = _vector(obj, offsets_key, names, text, src)
-    std = _vector(obj, std_offsets_key, names, text, src, required=False, std=True)
-    maemm = _vector(obj, MAEMM_KEY, measuring, text, src, required=False)
+    off = fits(_vector, obj, offsets_key, names, text, src)
+    std = fits(_vector, obj, std_offsets_key, names, text, src, required=False, std=True)
+    maemm = fits(_vector, obj, MAEMM_KEY, measuring, text, src, required=False)
     success = obj.get("success", True)
     for key in ("status", "method"):
         if obj.get(key) is not None and not isinstance(obj[key], str):
@@ -377,16 +382,14 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     if not success and not allow_failed:
         raise DataFileError(f"the identification failed (status: {status or '?'}); it must not be used as a "
                             "calibration", where=_where(text, "success", src))
-    estimate = _by_name(obj, "estimate", mech, text, src, "value")
-    stds = _by_name(obj, "std", mech, text, src, "std")
-    units = _by_name(obj, "units", mech, text, src, "unit")
+    estimate = fits(_by_name, obj, "estimate", mech, text, src, "value")
+    stds = fits(_by_name, obj, "std", mech, text, src, "std")
+    units = fits(_by_name, obj, "units", mech, text, src, "unit")
     off = _merge("estimate", estimate, offsets_key, names, off, text, src)
     std = _merge("std", stds, std_offsets_key, names, std, text, src)
     maemm = _merge("estimate", estimate, MAEMM_KEY, measuring, maemm, text, src)
-    if mech is not None:
-        _check_names(obj, "joint_names", mech.joint_names, text, src)
-        _check_names(obj, "pose_names", mech.pose_names, text, src)
-    std = _compensation(obj, names, off, std, None if mech is None else mech.joint_names, text, src, unit)
+    fits(_check_names, obj, "joint_names", mech.joint_names, text, src)
+    fits(_check_names, obj, "pose_names", mech.pose_names, text, src)
+    std = _compensation(obj, names, off, std, mech.joint_names, text, src, unit)
     return ResultFile(off, std, maemm, obj.get("method") or "?", status, success, _find_sha(obj, text, src), obj, src,
-                      mechanism=None if mech is None else mech.name, estimate=estimate, std=stds, units=units,
-                      offset_unit=unit)
+                      mechanism=mech.name, estimate=estimate, std=stds, units=units, offset_unit=unit)
