@@ -216,7 +216,6 @@ def _find_mechanism(obj, text, src):
     """The ``mechanism`` key (and ``robot.mechanism``, which must agree), checked; None without."""
     from zerocal_sym.model.mechanism import is_known
 
-    known = known_mechanisms()
     named = [(k, v) for k, v in (("mechanism", obj.get("mechanism")),
                                  ("robot.mechanism", _robot_block(obj, text, src).get("mechanism"))) if v is not None]
     for k, v in named:
