@@ -85,7 +85,7 @@ def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tupl
             if ok:
                 j = max(ok, key=lambda j: pk[j])
                 k = j + 1
-                e = float(out["dropped_error_mm"][j, j])
+                e = float(out["dropped_error_mm"][j])
                 c, d = float(out["chi2"][j]), int(out["dof"][j])
                 text = (f"the reading at pose {k} (the change from pose {k - 1} to pose {k}) is off by about "
                         f"{e:+.3g} mm")

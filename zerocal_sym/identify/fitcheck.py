@@ -75,7 +75,7 @@ from zerocal_sym.identify.diagnosis import (_diagnose, _paragraph, _summary, _va
                                             finish)
 from zerocal_sym.identify.exact_refits import REFINE_TOL, _Exact, _without_each, refits  # noqa: F401
 from zerocal_sym.identify.fitstats import (DEFAULT_ALPHA, LEVERAGE_TOL, RANK_RTOL, _fmt_p, _Linear,  # noqa: F401
-                                           _noise_dict, band_whitener, statistics)
+                                           _noise_dict, statistics)
 
 #: a zero offset beyond this (deg) is not a zero offset but a wrong joint zero / sign / robot file
 DEFAULT_MAX_OFFSET_DEG = 10.0
@@ -197,7 +197,7 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
         out = _without_each(exact, z)
         dz = out["z"] - z
         dz[~np.isfinite(out["chi2"]) | (out["dof"] <= 0) & (lin.dof <= 0)] = np.nan
-        delta = np.array([out["dropped_error_mm"][j, j] for j in range(lin.n)])
+        delta = out["dropped_error_mm"]
         chi2w = out["chi2"]
         # a reading the parameters need (leverage 1): its removal leaves them unidentifiable
         dz[lev > 1 - 1e-9] = np.nan

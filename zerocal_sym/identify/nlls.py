@@ -228,8 +228,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]
         lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
                       np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
-                      None, np.arange(1, K), s - pred, np.eye(len(names)),
-                      scale, names, len(rows), band=(l, b),
+                      (l, b), np.arange(1, K), s - pred, np.eye(len(names)),
+                      scale, names, len(rows),
                       svd=None if rows.size else svd,  # no prior rows: J's SVD is Jd's
                       terms=terms)
         at = "estimate"
