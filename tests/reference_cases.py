@@ -112,8 +112,9 @@ def summary(res) -> dict:
 
 def deletion_summary(d) -> dict:
     return _f({"flagged": d["flagged"], "most_influential": d["most_influential"], "dof": d["dof"],
-               "readings": [{k: r[k] for k in ("pose", "leverage", "standardised", "estimated_error_mm",
-                                              "chi2_without", "change", "flag")} for r in d["readings"]]})
+               "readings": [{k: r.get(k) for k in ("pose", "leverage", "standardised", "estimated_error_mm",
+                                                  "chi2_without", "change", "flag", "refit_converged")}
+                            for r in d["readings"]]})
 
 
 def conditioning(robot, meas, res, noise) -> dict:

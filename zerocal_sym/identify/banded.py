@@ -97,20 +97,21 @@ def cholesky(d, e):
     d, e = np.asarray(d, float), np.asarray(e, float)
     n = d.shape[-1]
     if d.ndim == 1:  # one matrix: a loop on Python floats (fastest for long n)
-        l, b = np.empty(n), np.empty(max(n - 1, 0))
-        dl, el = d.tolist(), e.tolist()
-        prev, ok = 0.0, True
-        for k in range(n):
-            q = dl[k] - prev * prev
-            if not q > 0 or not math.isfinite(q):
-                l[k:], b[max(k - 1, 0):] = np.nan, np.nan
-                ok = False
+        ls, bs = [], []
+        prev, sqrt, inf = 0.0, math.sqrt, math.inf
+        for dk, ek in zip(d.tolist(), e.tolist() + [0.0]):
+            q = dk - prev * prev
+            if not 0.0 < q < inf:
                 break
-            lk = math.sqrt(q)
-            l[k] = lk
-            if k < n - 1:
-                prev = el[k] / lk
-                b[k] = prev
+            lk = sqrt(q)
+            ls.append(lk)
+            prev = ek / lk
+            bs.append(prev)
+        ok = len(ls) == n
+        l, b = np.full(n, np.nan), np.full(max(n - 1, 0), np.nan)
+        l[: len(ls)] = ls
+        m = min(len(ls), n - 1) if ok else max(len(ls) - 1, 0)
+        b[:m] = bs[:m]
         return l, b, ok
     l, b = np.empty(d.shape), np.empty(e.shape)
     prev = np.zeros(d.shape[:-1])

@@ -29,7 +29,7 @@ class _Exact:
     def __init__(self, robot, theta_cmd, readings, names, prior_q, noise, prior_whitener=None):
         from zerocal_sym.identify import fisher
         from zerocal_sym.identify.nlls import noise_terms
-        from zerocal_sym.identify.nlls_problem import get_problem
+        from zerocal_sym.identify.nlls_banded import round_problem
 
         self.robot = robot
         self.theta = np.atleast_2d(np.asarray(theta_cmd, float))
@@ -43,7 +43,7 @@ class _Exact:
         self.mu = errors.take(self.prior_q, self.names)
         self.w = np.zeros((self.p, self.p)) if prior_whitener is None else np.asarray(prior_whitener, float)
         self.noise = noise
-        self.prob = get_problem(robot, self.K, self.names)
+        self.prob = round_problem(robot, self.K, self.names)
         self.par = self.prob.pack(self.theta, robot.geometry, self.prior_q, self.readings[1:], self.scale, self.mu,
                                   self.w, *noise_terms(noise))
 
@@ -124,10 +124,10 @@ class _Exact:
         return (chi2 if np.isfinite(chi2) else float("inf")), dof
 
 
-def _without_each(exact: "_Exact", z_est=None) -> dict:
+def _without_each(exact: "_Exact", z_est=None, select=None) -> dict:
     """Exact refits without each single reading, from the prior and from ``z_est``; the lower chi² per reading
-    (:func:`~zerocal_sym.identify.leave_out.without_each`)."""
+    (:func:`~zerocal_sym.identify.leave_out.without_each`; ``select``: the readings refitted exactly)."""
     starts = [exact.z_prior] if z_est is None or np.allclose(z_est, exact.z_prior) else [exact.z_prior, z_est]
     rnd = _Round(exact.robot, exact.theta, exact.readings, exact.names, exact.prior_q, exact.noise,
                  exact.w if np.any(exact.w) else None)
-    return without_each(rnd, starts)
+    return without_each(rnd, starts, select=select)

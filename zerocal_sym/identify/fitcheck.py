@@ -164,8 +164,10 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
 
     ``method="refit"`` (default): the exact model refitted without the
     reading (the change of the correlated changes' covariance marginalised,
-    Gauss-Newton from the estimate and from the prior, the better fit kept;
-    one vectorised pass for all readings).  ``method="one-step"``: the
+    Gauss-Newton from the data's fit reached from the estimate and from the
+    prior, the better fit kept; every reading's first step a rank-one update
+    of one evaluation, then exact steps per reading:
+    :func:`~zerocal_sym.identify.leave_out.without_each`, O(K) per reading).  ``method="one-step"``: the
     mean-shift formula on the whitened model linearised at the estimate,
     ``dz_k = -F^+ J^T a_k delta_k`` (exact for the linearised model; poor when
     a large outlier has dragged the estimate far).
@@ -183,7 +185,10 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
         ``standardised``, ``estimated_error_mm`` (its misfit without it),
         ``change`` (name -> change in user units, deg / mm; None when removing
         it leaves the parameters unidentifiable), ``change_in_std`` (name ->
-        |change| / std), ``chi2_without``, ``flag``; ``flagged`` (poses, the
+        |change| / std), ``chi2_without``, ``refit_converged`` (whether the
+        refit without it converged; None for ``one-step``: where the rest of
+        the readings still do not fit, Gauss-Newton may stop after its
+        iterations wherever it is), ``flag``; ``flagged`` (poses, the
         most influential first), ``most_influential`` (pose), ``summary`` (a
         sentence naming them), ``threshold``, ``dof``, ``method``.
     """
@@ -193,12 +198,14 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
     lin = exact.linear(z, basis)
     t, lev, delta, dz = lin.per_reading()
     chi2w = np.full(lin.n, np.nan)
+    conv = [None] * lin.n
     if method == "refit":
         out = _without_each(exact, z)
         dz = out["z"] - z
         dz[~np.isfinite(out["chi2"]) | (out["dof"] <= 0) & (lin.dof <= 0)] = np.nan
         delta = out["dropped_error_mm"]
         chi2w = out["chi2"]
+        conv = [bool(c) for c in out["converged"]]
         # a reading the parameters need (leverage 1): its removal leaves them unidentifiable
         dz[lev > 1 - 1e-9] = np.nan
     errors = robot.errors
@@ -217,6 +224,7 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
                      "standardised": None if not np.isfinite(t[j]) else float(t[j]),
                      "estimated_error_mm": None if not np.isfinite(delta[j]) else float(delta[j]),
                      "chi2_without": None if not np.isfinite(chi2w[j]) else float(chi2w[j]),
+                     "refit_converged": conv[j],
                      "change": ({n: errors.to_user_value(n, float(v)) for n, v in zip(names, dp)} if ok else None),
                      "change_in_std": ({n: float(v) for n, v in zip(names, ratio)} if ok else None),
                      "flag": bool(score[-1] > threshold)})

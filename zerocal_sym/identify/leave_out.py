@@ -33,8 +33,10 @@ import numpy as np
 
 from zerocal_sym.identify import banded
 
-#: the fits of one batch hold about this many numbers of their (n, p) arrays (memory ~ 8 bytes x 6 x this)
-BATCH_NUMBERS = 4_000_000
+#: the kinematics of a batch of fits is evaluated at about this many poses in one call (fits x K; at least
+#: one fit): the calls have one size (the generated functions mapped over it are cached, their buffers
+#: with them) and the fits' (K, p) arrays stay within a few tens of MB
+BATCH_POSES = 1 << 15
 
 
 class _Round:
@@ -63,11 +65,17 @@ class _Round:
 
     def evaluate(self, Z):
         """At the N points ``Z`` (N, p): ``e`` (N, n) measured minus predicted changes, ``A`` (N, n, p)
-        ``d pred / d z``, and the covariance of the changes as bands ``d`` (N, n), ``off`` (N, n-1)."""
+        ``d pred / d z``, and the covariance of the changes as bands ``d`` (N, n), ``off`` (N, n-1).
+
+        The points are padded to a power of two (at most :meth:`batch`): the kinematics is mapped over a
+        few numbers of poses only (each mapped function is cached with its buffers)."""
         from zerocal_sym.model import kinematics as kin
 
         Z = np.atleast_2d(Z)
-        N, K = Z.shape[0], self.K
+        N0, K = Z.shape[0], self.K
+        N = min(max(self.batch(), N0), 1 << int(np.ceil(np.log2(N0))))
+        if N > N0:
+            Z = np.vstack([Z, np.repeat(Z[-1:], N - N0, axis=0)])
         E = np.tile(self.prior_q, (N * K, 1))
         E[:, self.idx] = np.repeat(Z / self.scale, K, axis=0)
         with np.errstate(invalid="ignore", over="ignore"):
@@ -75,15 +83,15 @@ class _Round:
         e = self.s - np.diff(rho.reshape(N, K), axis=1)
         A = np.diff(de[:, self.idx].reshape(N, K, self.p), axis=1) / self.scale
         v = self.sx2 * np.sum(dt**2, axis=1).reshape(N, K)
-        return e, A, self.sm2 + v[:, :-1] + v[:, 1:], -v[:, 1:-1]
+        return e[:N0], A[:N0], (self.sm2 + v[:, :-1] + v[:, 1:])[:N0], -v[:N0, 1:-1]
 
     def prior_residual(self, Z):
         """Whitened prior residuals (N, rows) at ``Z`` (N, p)."""
         return (np.atleast_2d(Z) / self.scale - self.mu) @ self.w.T
 
     def batch(self) -> int:
-        """How many fits are evaluated together (their (n, p) arrays within :data:`BATCH_NUMBERS`)."""
-        return max(1, BATCH_NUMBERS // (self.K * (self.p + 2)))
+        """How many fits are evaluated together (:data:`BATCH_POSES` poses)."""
+        return max(1, BATCH_POSES // self.K)
 
 
 def _lstsq(M, y, rows):
@@ -191,7 +199,7 @@ def full_fit(rnd: _Round, z0, tol: float, max_iter: int):
     return z, False
 
 
-def without_each(rnd: _Round, starts, max_iter: int = 20, tol: float = 1e-7) -> dict:
+def without_each(rnd: _Round, starts, max_iter: int = 20, tol: float = 1e-7, select=None) -> dict:
     """The exact fits of one round each without one reading (leave-one-out form, module docstring).
 
     From each start (scaled units) the full data are fitted first; the n
@@ -199,15 +207,24 @@ def without_each(rnd: _Round, starts, max_iter: int = 20, tol: float = 1e-7) -> 
     another's did adds nothing and is skipped).  Per reading the fit with the
     lower chi² over the starts is kept.
 
+    ``select``: ``select(chi2_lin, chi2_start, dof) -> mask`` (n,) of the
+    readings refitted exactly, from the chi² each fit has at the start
+    (``chi2_start``) and after its first step in the model linearised there
+    (``chi2_lin``; O(n p^2) for all); the others stop there (``refitted``
+    False: their ``z`` and ``chi2`` are the linearised model's).  Default: every reading refitted (n exact fits: O(n^2) model
+    evaluations).
+
     Returns
     -------
     dict
         ``z`` (n, p), ``chi2`` (n,), ``dof`` (n,), ``converged`` (n,) bool,
-        ``dropped_error_mm`` (n,): the reading's misfit given the others at
-        its fit (its residual minus what the others' correlated residuals
-        predict for it) -- the estimated error of that reading.
+        ``refitted`` (n,) bool, ``dropped_error_mm`` (n,): the reading's
+        misfit given the others at its fit (its residual minus what the
+        others' correlated residuals predict for it) -- the estimated error of
+        that reading.
     """
     n, p = rnd.n, rnd.p
+    dof = (n - 1) + rnd.w.shape[0] - p
     out, seen = None, []
     for z0 in starts:
         z_full, ok = full_fit(rnd, z0, tol, max_iter)
@@ -215,24 +232,25 @@ def without_each(rnd: _Round, starts, max_iter: int = 20, tol: float = 1e-7) -> 
         if any(np.max(np.abs(start - s)) < tol for s in seen):
             continue
         seen.append(start)
-        one = _leave_one_out(rnd, start, tol, max_iter)
+        one = _leave_one_out(rnd, start, tol, max_iter, (lambda c, c0: select(c, c0, dof)) if select else None)
         if out is None:
             out = one
             continue
         better = one["chi2"] < out["chi2"]
         for key in out:
             out[key][better] = one[key][better]
-    out["dof"] = np.full(n, (n - 1) + rnd.w.shape[0] - p)
+    out["dof"] = np.full(n, dof)
     return out
 
 
-def _leave_one_out(rnd: _Round, z0, tol, max_iter) -> dict:
-    """The n fits each without one reading from the common point ``z0`` (module docstring)."""
+def _leave_one_out(rnd: _Round, z0, tol, max_iter, select=None) -> dict:
+    """The n fits each without one reading from the common point ``z0`` (module docstring);
+    ``select(chi2_lin, chi2_start)``: the readings refitted exactly (:func:`without_each`)."""
     n, p = rnd.n, rnd.p
     Z = np.tile(np.asarray(z0, float), (n, 1))
     chi2, err = np.full(n, np.inf), np.full(n, np.nan)
-    done, bad = np.zeros(n, bool), np.zeros(n, bool)
-    out = {"z": Z, "chi2": chi2, "converged": done, "dropped_error_mm": err}
+    done, bad, refit = np.zeros(n, bool), np.zeros(n, bool), np.ones(n, bool)
+    out = {"z": Z, "chi2": chi2, "converged": done, "refitted": refit, "dropped_error_mm": err}
     # the first step of every fit from the common point: a rank-one downdate of its normal equations
     e, A, d, off = rnd.evaluate(Z[:1])
     l, b, ok = banded.cholesky(d[0], off[0])
@@ -255,15 +273,21 @@ def _leave_one_out(rnd: _Round, z0, tol, max_iter) -> dict:
     small = np.max(np.abs(step), axis=1) < tol
     bad |= ~np.all(np.isfinite(step), axis=1)
     done |= small & ~bad
-    Z[~done & ~bad] += step[~done & ~bad]
+    go = ~done & ~bad
+    if select is not None:  # the others end after the step, in the linearised model
+        lin = chi2 + 2 * np.sum(step * gj, axis=1) + np.einsum("ni,nij,nj->n", step, Fj, step)
+        refit[:] = np.asarray(select(np.where(bad, np.inf, lin), chi2.copy()), bool)
+        chi2[go & ~refit] = lin[go & ~refit]
+        done &= refit
+    Z[go] += step[go]
     # then each fit on its own: exact steps at its iterate (the projected problem, the full band)
     for _ in range(max_iter - 1):
-        active = np.flatnonzero(~done & ~bad)
+        active = np.flatnonzero(~done & ~bad & refit)
         if not active.size:
             break
         for part in _chunks(active, rnd.batch()):
             _step(rnd, Z, part, chi2, err, done, bad, tol, take=True)
-    rest = np.flatnonzero(~done & ~bad)
+    rest = np.flatnonzero(~done & ~bad & refit)
     for part in _chunks(rest, rnd.batch()):  # not converged: the chi² where they stopped
         _step(rnd, Z, part, chi2, err, done, bad, tol, take=False)
     chi2[bad] = np.inf

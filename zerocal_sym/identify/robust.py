@@ -39,6 +39,17 @@ import numpy as np
 
 #: default loss scale (standard deviations)
 DEFAULT_SCALE = {"huber": 1.345, "soft_l1": 1.0}
+#: the exact refits without one reading among which the best deletion start is taken: the readings whose
+#: linearised removal lowers chi² most
+DELETION_CANDIDATES = 8
+
+
+def lowest(values, k: int) -> np.ndarray:
+    """Bool mask of the ``k`` lowest of ``values`` (non-finite last)."""
+    v = np.asarray(values, float)
+    mask = np.zeros(v.size, bool)
+    mask[np.argsort(np.where(np.isfinite(v), v, np.inf), kind="stable")[:k]] = True
+    return mask
 
 
 def weights(loss: str, u, delta: float) -> np.ndarray:
@@ -204,9 +215,11 @@ def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delt
     args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
     cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
     if K - 2 > len(names):
-        drop = without_each(_Round(*args, pw), [z_l2])
-        if np.any(np.isfinite(drop["chi2"])):
-            j = int(np.argmin(drop["chi2"]))
+        # the readings whose linearised removal lowers chi² most, refitted exactly
+        drop = without_each(_Round(*args, pw), [z_l2], select=lambda c, c0, d: lowest(c, DELETION_CANDIDATES))
+        chi2 = np.where(drop["refitted"], drop["chi2"], np.inf)
+        if np.any(np.isfinite(chi2)):
+            j = int(np.argmin(chi2))
             cands += [(drop["z"][j], None), (drop["z"][j], j)]
     best = None
     for z0, j in cands:
