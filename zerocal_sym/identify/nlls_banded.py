@@ -146,28 +146,28 @@ class BandedProblem:
         return [self.residuals(z, par, l, b)[2][: self.K - 1]]
 
     def run_gauss_newton(self, z0, par, reweight: bool, tol: float):
-        """Blocks of damped Gauss-Newton from ``z0`` until the last step is below ``tol`` (at most
-        ``GN_BLOCKS`` blocks of ``N_GN`` iterations), as :meth:`NllsProblem.run_gauss_newton
-        <zerocal_sym.identify.nlls_problem.NllsProblem.run_gauss_newton>`: ``z, last_step, r, r_prior, J,
-        pred, l, b``."""
+        """Damped Gauss-Newton from ``z0`` until the last step is below ``tol`` (at most ``GN_BLOCKS`` x
+        ``N_GN`` iterations), as :meth:`NllsProblem.run_gauss_newton
+        <zerocal_sym.identify.nlls_problem.NllsProblem.run_gauss_newton>` (which checks after blocks of
+        ``N_GN``; here every iteration is checked: one evaluation of the kinematics each): ``z, last_step, r,
+        r_prior, J, pred, l, b``."""
         z = np.asarray(z0, float).ravel().copy()
         fixed = None if reweight else self.weights(z, par)
         last = np.inf
-        for _ in range(GN_BLOCKS):
-            for _ in range(N_GN):
-                l, b = self.weights(z, par) if reweight else fixed
-                r, rp, J, _ = self.residuals(z, par, l, b)
-                res = np.concatenate([r, rp])
-                with np.errstate(invalid="ignore", over="ignore"):
-                    JtJ = J.T @ J
-                    ridge = 1e-12 * (np.max(np.diag(JtJ)) + 1e-300)
-                    try:
-                        dz = -np.linalg.solve(JtJ + ridge * np.eye(self.p), J.T @ res)
-                    except np.linalg.LinAlgError:
-                        dz = np.full(self.p, np.nan)
-                z = z + dz
-                last = float(np.max(np.abs(dz))) if np.all(np.isfinite(dz)) else np.nan
-            if not np.all(np.isfinite(z)) or last < tol:
+        for _ in range(GN_BLOCKS * N_GN):
+            l, b = self.weights(z, par) if reweight else fixed
+            r, rp, J, _ = self.residuals(z, par, l, b)
+            res = np.concatenate([r, rp])
+            with np.errstate(invalid="ignore", over="ignore"):
+                JtJ = J.T @ J
+                ridge = 1e-12 * (np.max(np.diag(JtJ)) + 1e-300)
+                try:
+                    dz = -np.linalg.solve(JtJ + ridge * np.eye(self.p), J.T @ res)
+                except np.linalg.LinAlgError:
+                    dz = np.full(self.p, np.nan)
+            z = z + dz
+            last = float(np.max(np.abs(dz))) if np.all(np.isfinite(dz)) else np.nan
+            if not np.all(np.isfinite(z)) or not last >= tol:
                 break
         l, b = self.weights(z, par) if reweight else fixed
         r, rp, J, pred = self.residuals(z, par, l, b)
