@@ -1,15 +1,15 @@
-"""Tridiagonal covariances of the changes and their bidiagonal Cholesky factors: O(n) algebra, batched.
+"""Tridiagonal covariances of the changes and their bidiagonal Cholesky factors: O(K) algebra, batched.
 
-The covariance of the n = K - 1 measured changes, ``C = sigma_m^2 I + D diag(v) D^T``
-(:class:`~zerocal_sym.identify.fisher.ChangeCovariance`), is tridiagonal: diagonal ``d`` (n,),
-off-diagonal ``e`` (n-1,) (``C[k+1, k] = C[k, k+1] = e[k]``).  Its Cholesky factor ``L`` is lower
-bidiagonal: diagonal ``l`` (n,), sub-diagonal ``b`` (n-1,) (``L[k+1, k] = b[k]``).  Everything here is
-linear in n; nothing builds an n x n matrix.
+The covariance of the K - 1 measured changes, ``C = sigma_m^2 I + D diag(v) D^T``
+(:class:`~zerocal_sym.identify.fisher.ChangeCovariance`), is tridiagonal: diagonal ``d`` (K-1,),
+off-diagonal ``e`` (K-2,) (``C[k+1, k] = C[k, k+1] = e[k]``).  Its Cholesky factor ``L`` is lower
+bidiagonal: diagonal ``l`` (K-1,), sub-diagonal ``b`` (K-2,) (``L[k+1, k] = b[k]``).  Everything here is
+linear in K; nothing builds a (K-1) x (K-1) matrix.
 
-Arrays may carry leading batch axes (N fits): ``d`` (N, n), ``e`` (N, n-1), right-hand sides (N, n) or
-(N, n, c).  The triangular solves are affine recurrences ``y_k = alpha_k y_{k-1} + beta_k`` evaluated as
-a parallel prefix (:func:`scan`: log2 n vectorised steps); the factorisation itself is a loop over n
-(vectorised over the batch).
+Arrays may carry leading batch axes (N fits): ``d`` (N, K-1), ``e`` (N, K-2), right-hand sides (N, K-1)
+or (N, K-1, c) (c columns, e.g. the p parameters).  The triangular solves are affine recurrences
+``y_k = alpha_k y_{k-1} + beta_k`` evaluated as a parallel prefix (:func:`scan`: log2 K vectorised steps);
+the factorisation itself is a loop over the changes (vectorised over the batch).
 """
 from __future__ import annotations
 
@@ -19,10 +19,10 @@ import numpy as np
 
 
 def scan(alpha, beta) -> np.ndarray:
-    """``y_k = alpha_k y_{k-1} + beta_k`` (``y_{-1} = 0``; ``alpha_0`` unused) along the n axis.
+    """``y_k = alpha_k y_{k-1} + beta_k`` (``y_{-1} = 0``; ``alpha_0`` unused) along the axis of the changes.
 
-    ``alpha`` (..., n); ``beta`` (..., n) or (..., n, c) (a new array is returned).  Hillis-Steele
-    scan of the affine maps: ceil(log2 n) vectorised steps, O(n c log n) flops, O(n c) memory.
+    ``alpha`` (..., K-1); ``beta`` (..., K-1) or (..., K-1, c) (a new array is returned).  Hillis-Steele
+    scan of the affine maps: ceil(log2 K) vectorised steps, O(K c log K) flops, O(K c) memory.
     """
     Y = np.array(beta, float)
     vec = Y.ndim == np.ndim(alpha)
@@ -39,7 +39,7 @@ def scan(alpha, beta) -> np.ndarray:
 
 
 def _cols(l, V):
-    """``V`` with the n axis second to last (a trailing column axis added for a vector), and whether it was one."""
+    """``V`` with the axis of the changes second to last (a column axis added to a vector), and whether it was one."""
     V = np.asarray(V, float)
     vec = V.ndim == np.ndim(l)
     return (V[..., None] if vec else V), vec
@@ -71,7 +71,7 @@ def solve(l, b, V) -> np.ndarray:
 
 
 def inverse_diagonal(l, b) -> np.ndarray:
-    """The diagonal of ``C^-1`` (..., n): ``|L^-1 e_j|^2 = S_j / l_j^2``, ``S_j = 1 + (b_j / l_{j+1})^2 S_{j+1}``."""
+    """The diagonal of ``C^-1`` (..., K-1): ``|L^-1 e_j|^2 = S_j / l_j^2``, ``S_j = 1 + (b_j / l_{j+1})^2 S_{j+1}``."""
     l, b = np.asarray(l, float), np.asarray(b, float)
     alpha = np.zeros(l.shape)
     alpha[..., 1:] = ((b / l[..., 1:]) ** 2)[..., ::-1]

@@ -1,26 +1,26 @@
 """Exact-model refits of one round without some of its readings, in banded, leave-one-out form.
 
-Shapes: K poses, n = K - 1 measured changes, p estimated parameters, N fits.
+Shapes: K poses (K - 1 measured changes), p estimated parameters, N fits.
 
 Leaving readings out of the correlated changes marginalises them out of
 their covariance ``C`` (tridiagonal): the kept readings' covariance
 ``C[keep][:, keep]`` is tridiagonal again, so every fit is whitened by a
-bidiagonal Cholesky factor in O(n) (:mod:`~zerocal_sym.identify.banded`).
+bidiagonal Cholesky factor in O(K) (:mod:`~zerocal_sym.identify.banded`).
 Each fit is Gauss-Newton on the exact model with the weights re-evaluated at
 every iterate, until the step is below ``tol`` (mm, scaled units).
 
 :func:`refits` -- a few fits, each without a set of readings.
 
-:func:`without_each` -- the n fits each without one reading, in leave-one-out
-form.  Without reading ``j`` the whitened problem is the full one projected
+:func:`without_each` -- the K - 1 fits each without one reading, in
+leave-one-out form.  Without reading ``j`` the whitened problem is the full one projected
 orthogonally to the whitened indicator ``a_j = L^-1 e_j``::
 
     chi2_j = |r|^2 - (a_j^T r)^2 / |a_j|^2,    F_j = F - g_j g_j^T / |a_j|^2,   g_j = J^T a_j,
 
 (``|a_j|^2`` is entry j of the diagonal of ``C^-1``, ``a_j^T r`` entry j of
 ``L^-T r``, ``g_j`` row j of ``L^-T J``), so the first Gauss-Newton step of all
-n fits from one point is a rank-one downdate of that point's normal
-equations: one evaluation of the model and O(n p^2) for all of them.  The
+K - 1 fits from one point is a rank-one downdate of that point's normal
+equations: one evaluation of the model and O(K p^2) for all of them.  The
 fits start from the full data's fit (Gauss-Newton from each start given), so
 that one step leaves each within a few of its own minimum; every fit then
 takes exact steps at its own iterate (the projected problem, whitened with
@@ -64,8 +64,8 @@ class _Round:
         self.sm2, self.sx2 = noise_terms(noise)
 
     def evaluate(self, Z):
-        """At the N points ``Z`` (N, p): ``e`` (N, n) measured minus predicted changes, ``A`` (N, n, p)
-        ``d pred / d z``, and the covariance of the changes as bands ``d`` (N, n), ``off`` (N, n-1).
+        """At the N points ``Z`` (N, p): ``e`` (N, K-1) measured minus predicted changes, ``A`` (N, K-1, p)
+        ``d pred / d z``, and the covariance of the changes as bands ``d`` (N, K-1), ``off`` (N, K-2).
 
         The points are padded to a power of two (at most :meth:`batch`): the kinematics is mapped over a
         few numbers of poses only (each mapped function is cached with its buffers)."""
@@ -116,7 +116,7 @@ def refits(robot, theta_cmd, readings, names, prior_q, noise, drops, z0, prior_w
     the changes: Gauss-Newton with the weights re-evaluated at each iterate,
     from ``z0[j]`` (scaled units), until the step is below ``tol`` (mm) or
     ``max_iter``.  Each fit O(K p^2) per iteration, the fits' model
-    evaluations batched.  For the fits each without one reading, all n of
+    evaluations batched.  For the fits each without one reading, all K - 1 of
     them: :func:`without_each`.
 
     Returns
@@ -202,23 +202,23 @@ def full_fit(rnd: _Round, z0, tol: float, max_iter: int):
 def without_each(rnd: _Round, starts, max_iter: int = 20, tol: float = 1e-7, select=None) -> dict:
     """The exact fits of one round each without one reading (leave-one-out form, module docstring).
 
-    From each start (scaled units) the full data are fitted first; the n
+    From each start (scaled units) the full data are fitted first; the K - 1
     fits without one reading start there (a start whose full fit lands where
     another's did adds nothing and is skipped).  Per reading the fit with the
     lower chi² over the starts is kept.
 
-    ``select``: ``select(chi2_lin, chi2_start, dof) -> mask`` (n,) of the
+    ``select``: ``select(chi2_lin, chi2_start, dof) -> mask`` (K-1,) of the
     readings refitted exactly, from the chi² each fit has at the start
     (``chi2_start``) and after its first step in the model linearised there
-    (``chi2_lin``; O(n p^2) for all); the others stop there (``refitted``
-    False: their ``z`` and ``chi2`` are the linearised model's).  Default: every reading refitted (n exact fits: O(n^2) model
-    evaluations).
+    (``chi2_lin``; O(K p^2) for all); the others stop there (``refitted``
+    False: their ``z`` and ``chi2`` are the linearised model's).  Default:
+    every reading refitted (K - 1 exact fits: O(K^2) model evaluations).
 
     Returns
     -------
     dict
-        ``z`` (n, p), ``chi2`` (n,), ``dof`` (n,), ``converged`` (n,) bool,
-        ``refitted`` (n,) bool, ``dropped_error_mm`` (n,): the reading's
+        ``z`` (K-1, p), ``chi2`` (K-1,), ``dof`` (K-1,), ``converged`` (K-1,)
+        bool, ``refitted`` (K-1,) bool, ``dropped_error_mm`` (K-1,): the reading's
         misfit given the others at its fit (its residual minus what the
         others' correlated residuals predict for it) -- the estimated error of
         that reading.
@@ -244,7 +244,7 @@ def without_each(rnd: _Round, starts, max_iter: int = 20, tol: float = 1e-7, sel
 
 
 def _leave_one_out(rnd: _Round, z0, tol, max_iter, select=None) -> dict:
-    """The n fits each without one reading from the common point ``z0`` (module docstring);
+    """The K - 1 fits each without one reading from the common point ``z0`` (module docstring);
     ``select(chi2_lin, chi2_start)``: the readings refitted exactly (:func:`without_each`)."""
     n, p = rnd.n, rnd.p
     Z = np.tile(np.asarray(z0, float), (n, 1))
