@@ -431,8 +431,9 @@ def test_detection_rate_of_one_bad_reading(robot):
 
 
 def test_banded_per_reading_terms_equal_the_dense_ones(case):
-    """identify_nlls's per-reading statistics come from the O(K p) banded terms (nlls_problem._fit_terms); the
-    fit check recomputed with the dense whitener (fit_check) gives the same numbers, a bad reading included."""
+    """identify_nlls's per-reading statistics come from the O(K p) banded terms of its CasADi functions
+    (nlls_problem._fit_terms); the fit check recomputed by fit_check (fitstats' bidiagonal solves in numpy)
+    gives the same numbers, a bad reading included."""
     for th, bad in ((case.th_large, None), (case.th_large, (3, 0.05)), (case.th_small, None)):
         m = case.meas(th, seed=5, bad=bad)
         res = identify_nlls(case.robot, m, "paper", noise=PAPER, accept_misfit=True)

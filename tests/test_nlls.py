@@ -206,7 +206,9 @@ def test_batch_hands_unconfirmed_sets_to_the_single_path(robot, th6):
 
 
 def test_large_k_graph_gives_the_same_answer(robot, monkeypatch):
-    """Above EXPAND_MAX_K the problem is an MX graph (mapped model, mapaccum recurrences): same answer."""
+    """Above EXPAND_MAX_K a round is identified in numpy with the banded whitening (nlls_banded: Gauss-Newton,
+    Ipopt on callbacks) and the Monte Carlo's batches use an MX graph (mapped model, mapaccum recurrences):
+    same answer."""
     from zerocal_sym.identify import nlls_problem
 
     th = kin.ik(robot, paper_poses(robot, 5))

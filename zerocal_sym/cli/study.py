@@ -40,6 +40,7 @@ import numpy as np
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.cli.study_chunks import (_CHUNK_RE, ChunkError, _cell_json, check_directory, chunk_path, read_chunk,
                                           write_chunk)
+from zerocal_sym.cli.study_size import check_disk
 from zerocal_sym.cli.study_spec import Study, load_spec  # noqa: F401 - load_spec kept importable from here (benchmarks)
 from zerocal_sym.identify.one_shot import OneShotTask, one_shot_chunk
 from zerocal_sym.identify.dask_cluster import describe_scheduler
@@ -143,7 +144,9 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     ZerocalError
         Before anything is written: ``out`` holds another study
         (:func:`~zerocal_sym.cli.study_chunks.check_directory`), a cell's
-        cell.json other settings, a chunk file is refused (:func:`plan`).
+        cell.json other settings, a chunk file is refused (:func:`plan`),
+        the chunk files to write do not fit on the disk
+        (:func:`~zerocal_sym.cli.study_size.check_disk`).
     """
     from zerocal_sym.io.files import write_json
 
@@ -155,6 +158,7 @@ def run_study(study: Study, out, workers: int = 1, scheduler=None, progress=None
     for cell in study.cells:
         _cell_json(out, cell, study, check_only=True)
     todo, on_disk = plan(study, out)
+    check_disk(todo, out)  # the chunk files to write fit on the disk: before anything is written
     total = on_disk + len(todo)
     if log:
         log(f"study {study.name}: {len(study.cells)} cells x {study.chunks_per_cell} chunks of <= {study.chunk} "

@@ -34,7 +34,10 @@ Spec (paths relative to the spec file; angles in degrees, lengths in mm)::
 
 Errors in the spec are one line naming the file and the line; among them a
 parameter set that a design's poses cannot identify (rank of the sensitivity
-below the number of parameters, :func:`~zerocal_sym.cli._checks.identifiability_problem`).
+below the number of parameters, :func:`~zerocal_sym.cli._checks.identifiability_problem`),
+an ``n`` beyond ``--n``'s cap and a study this machine cannot hold
+(:mod:`zerocal_sym.cli.study_size`: the chunk files per cell, the memory of
+a cell's summary and of a chunk's identification).
 """
 from __future__ import annotations
 
@@ -46,6 +49,8 @@ from pathlib import Path
 
 import numpy as np
 
+from zerocal_sym.cli._checks import MAX_N
+from zerocal_sym.cli.study_size import check_spec
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.identify.parallel import chunk_ranges
 
@@ -351,6 +356,9 @@ def load_spec(path) -> Study:
                 if k in dt and not ok(dt[k]):
                     raise StudySpecError(f"{k} = {dt[k]!r}: expected "
                                          + ("an integer >= 2" if k == "n" else "a string"), where=wd(k))
+            if dt.get("n", 0) > MAX_N:  # as --n: before any pose is made
+                raise StudySpecError(f"n = {dt['n']}: at most {MAX_N} poses per boundary (K = 2n = {2 * MAX_N} "
+                                     "poses), as zerocal's --n", where=wd("n"))
             flt = _filter(dt, labels, wd)
             if flt is not None and rl not in flt:
                 continue
@@ -409,6 +417,7 @@ def load_spec(path) -> Study:
     if not study.cells:
         raise StudySpecError("no cell: every [[design]] or [[truth]] is filtered out for every robot",
                              where=str(path))
+    check_spec(study, where, StudySpecError)  # what this machine can hold: chunk files, memory
     study.inputs = ([("a robot file of the spec", base / r) for r in raw["robots"] if r != "paper"]
                     + [("a pose file of the spec", base / dt["poses"]) for dt in designs if "poses" in dt])
     return study

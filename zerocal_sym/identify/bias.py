@@ -217,11 +217,10 @@ def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None 
     err0 = errors.zeros() if err0 is None else errors.check_vector(err0)
     _, de, _ = kin.distance_jacobians(robot, np.atleast_2d(theta_cmd), err0)
     A, Ao = np.diff(de[:, idx], axis=0), np.diff(de[:, om], axis=0)
-    if noise.is_zero:
-        W = np.eye(A.shape[0])
-    else:
-        W = fisher.whitener(fisher.measurement_covariance(robot, theta_cmd, noise, err0))
-    S, *_ = np.linalg.lstsq(W @ A, W @ Ao, rcond=None)
+    if not noise.is_zero:  # whitened by the banded Cholesky factor of Cov(s), O(K p)
+        C = fisher.change_covariance(robot, theta_cmd, noise, err0)
+        A, Ao = C.whiten(A), C.whiten(Ao)
+    S, *_ = np.linalg.lstsq(A, Ao, rcond=None)
     return S, names
 
 

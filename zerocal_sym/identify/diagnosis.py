@@ -33,6 +33,42 @@ def _variants(K: int, theta, readings):
             yield (f"swap{j}", f"poses {j} and {j + 1} were visited in the other order", th, None)
 
 
+#: the readings refitted exactly when looking for one bad reading: those that would pass the check if the
+#: refit lowered chi² SCREEN_FACTOR times as much as the model linearised at the start says, and at least the
+#: SCREEN_KEEP that lower it most
+SCREEN_FACTOR = 2.0
+SCREEN_KEEP = 8
+
+
+def could_pass(chi2_lin, chi2_start, dof: int, alpha: float) -> np.ndarray:
+    """Which readings to refit exactly (bool (n,)).
+
+    ``chi2_start`` (n,): chi² without each reading at the start; ``chi2_lin``
+    (n,): after its first Gauss-Newton step in the linearised model.  A
+    reading is refitted when ``chi2_start - SCREEN_FACTOR (chi2_start -
+    chi2_lin)`` passes the check at ``alpha`` on ``dof`` (the exact model's
+    nonlinearity would have to more than double the drop to make another pass),
+    or when it is among the :data:`SCREEN_KEEP` lowest ``chi2_lin``.
+    """
+    c, c0 = np.asarray(chi2_lin, float), np.asarray(chi2_start, float)
+    bound = c0 - SCREEN_FACTOR * (c0 - c)
+    keep = np.zeros(c.size, bool)
+    if dof > 0:
+        cand = np.flatnonzero(np.isfinite(bound))
+        cand = cand[bound[cand] < chi2_isf_upper(alpha, dof)]
+        keep[cand] = [chi2_sf(max(bound[j], 0.0), dof) >= alpha for j in cand]
+    keep[np.argsort(np.where(np.isfinite(c), c, np.inf), kind="stable")[:SCREEN_KEEP]] = True
+    return keep
+
+
+def chi2_isf_upper(alpha: float, dof: int) -> float:
+    """An upper bound of the chi² at upper tail ``alpha`` on ``dof``: ``x = dof + 2 sqrt(dof t) + 2 t``,
+    ``t = ln(1/alpha)``, has ``sf(x) <= alpha`` (Laurent and Massart 2000); only the readings below it need
+    the exact tail."""
+    t = math.log(1.0 / alpha) if alpha > 0 else math.inf
+    return dof + 2.0 * math.sqrt(dof * t) + 2.0 * t
+
+
 def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tuple:
     """(causes, paragraph) of a rejected fit."""
     chi2, dof = fit["chi2"], fit["dof"]
@@ -71,21 +107,24 @@ def _diagnose(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tupl
                            "detected": True, "text": text,
                            "evidence": f"refitted so, chi2 = {c:.4g} on {d} dof ({_fmt_p(p)})"})
     # one bad reading: exact refits, each without one reading (from the prior: an outlier may have dragged
-    # the estimate far along a weak direction, where the linearisation at the estimate says little)
+    # the estimate far along a weak direction, where the linearisation at the estimate says little), of the
+    # readings whose removal could pass (the screen: the linearised refit of every reading, O(K))
     if exact is not None and dof >= 2 and not causes:
         K1 = exact.K - 1
         try:
-            out = _without_each(exact, z_est)
+            out = _without_each(exact, z_est, select=lambda c, c0, d: could_pass(c, c0, d, alpha))
         except Exception:  # noqa: BLE001 - then no reading is named
             out = None
         if out is not None:
-            pk = np.array([chi2_sf(c, d) if d > 0 and np.isfinite(c) else np.nan
-                           for c, d in zip(out["chi2"], out["dof"])])
+            pk = np.full(K1, np.nan)
+            for j in np.flatnonzero(out["refitted"]):  # (the others cannot pass: could_pass)
+                c, d = out["chi2"][j], out["dof"][j]
+                pk[j] = chi2_sf(c, d) if d > 0 and np.isfinite(c) else np.nan
             ok = [j for j in range(K1) if np.isfinite(pk[j]) and pk[j] >= alpha and out["chi2"][j] < chi2]
             if ok:
                 j = max(ok, key=lambda j: pk[j])
                 k = j + 1
-                e = float(out["dropped_error_mm"][j, j])
+                e = float(out["dropped_error_mm"][j])
                 c, d = float(out["chi2"][j]), int(out["dof"][j])
                 text = (f"the reading at pose {k} (the change from pose {k - 1} to pose {k}) is off by about "
                         f"{e:+.3g} mm")

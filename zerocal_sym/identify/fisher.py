@@ -20,10 +20,9 @@ dense :func:`measurement_covariance` is for small K and tests).
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from zerocal_sym.identify import banded
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 from zerocal_sym.errors import PoseError
@@ -131,20 +130,9 @@ class ChangeCovariance:
             ``C`` is not positive definite (a zero noise model).
         """
         if self._chol is None:
-            d, e = self.diag, self.off
-            n = d.size
-            l, b = np.empty(n), np.empty(max(n - 1, 0))
-            dl, el = d.tolist(), e.tolist()
-            prev = 0.0
-            for k in range(n):  # l_k^2 = d_k - b_{k-1}^2, b_k = e_k / l_k
-                q = dl[k] - prev * prev
-                if not q > 0:
-                    raise np.linalg.LinAlgError("the covariance of the changes is not positive definite")
-                lk = math.sqrt(q)
-                l[k] = lk
-                if k < n - 1:
-                    prev = el[k] / lk
-                    b[k] = prev
+            l, b, ok = banded.cholesky(self.diag, self.off)
+            if not ok:
+                raise np.linalg.LinAlgError("the covariance of the changes is not positive definite")
             self._chol = (l, b)
         return self._chol
 
@@ -175,6 +163,23 @@ class ChangeCovariance:
         """``L^-1`` dense, shape (K-1, K-1) (small problems only)."""
         return self.whiten(np.eye(self.n))
 
+    def solve(self, V) -> np.ndarray:
+        """``C^-1 V``, ``V`` shape (K-1,) or (K-1, p); O(K p)."""
+        l, b = self.cholesky()
+        return banded.solve(l, b, V)
+
+    def inverse_diagonal(self) -> np.ndarray:
+        """The diagonal of ``C^-1``, shape (K-1,); O(K)."""
+        return banded.inverse_diagonal(*self.cholesky())
+
+    def take(self, keep) -> "ChangeCovariance":
+        """The covariance of the changes ``keep`` (sorted indices), the others marginalised out: tridiagonal."""
+        return ChangeCovariance(*banded.submatrix(self.diag, self.off, keep))
+
+    def plus_diagonal(self, x) -> "ChangeCovariance":
+        """``C + diag(x)``, ``x`` shape (K-1,)."""
+        return ChangeCovariance(self.diag + np.asarray(x, float), self.off)
+
 
 def band_forward(l, b, A) -> np.ndarray:
     """Solve ``L Y = A`` for lower-bidiagonal ``L`` (diagonal ``l`` (n,), sub-diagonal ``b`` (n-1,)).
@@ -183,21 +188,9 @@ def band_forward(l, b, A) -> np.ndarray:
     parallel prefix (log2 n vectorised steps of ``y_k = alpha_k y_{k-1} +
     beta_k``), O(n p log n) flops, O(n p) memory.
     """
-    l = np.asarray(l, float).ravel()
     A = np.asarray(A, float)
-    vec = A.ndim == 1
-    Y = (A.reshape(l.size, -1) / l[:, None]).copy()  # beta_k
-    n = l.size
-    if n > 1:
-        alpha = np.empty(n)
-        alpha[0] = 0.0
-        alpha[1:] = -np.asarray(b, float).ravel()[: n - 1] / l[1:]
-        s = 1
-        while s < n:  # Hillis-Steele scan of the affine maps y -> alpha y + beta
-            Y[s:] += alpha[s:, None] * Y[:-s]
-            alpha[s:] = alpha[s:] * alpha[:-s]
-            s *= 2
-    return Y.ravel() if vec else Y
+    return banded.forward(np.ravel(np.asarray(l, float)), np.ravel(np.asarray(b, float)), A.reshape(A.shape[0], -1)
+                          ).reshape(A.shape)
 
 
 def change_covariance(robot, theta_cmd, noise: NoiseModel, err0=None) -> ChangeCovariance:

@@ -75,7 +75,7 @@ from zerocal_sym.identify.diagnosis import (_diagnose, _paragraph, _summary, _va
                                             finish)
 from zerocal_sym.identify.exact_refits import REFINE_TOL, _Exact, _without_each, refits  # noqa: F401
 from zerocal_sym.identify.fitstats import (DEFAULT_ALPHA, LEVERAGE_TOL, RANK_RTOL, _fmt_p, _Linear,  # noqa: F401
-                                           _noise_dict, band_whitener, statistics)
+                                           _noise_dict, statistics)
 
 #: a zero offset beyond this (deg) is not a zero offset but a wrong joint zero / sign / robot file
 DEFAULT_MAX_OFFSET_DEG = 10.0
@@ -166,8 +166,10 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
 
     ``method="refit"`` (default): the exact model refitted without the
     reading (the change of the correlated changes' covariance marginalised,
-    Gauss-Newton from the estimate and from the prior, the better fit kept;
-    one vectorised pass for all readings).  ``method="one-step"``: the
+    Gauss-Newton from the data's fit reached from the estimate and from the
+    prior, the better fit kept; every reading's first step a rank-one update
+    of one evaluation, then exact steps per reading:
+    :func:`~zerocal_sym.identify.leave_out.without_each`, O(K) per reading).  ``method="one-step"``: the
     mean-shift formula on the whitened model linearised at the estimate,
     ``dz_k = -F^+ J^T a_k delta_k`` (exact for the linearised model; poor when
     a large outlier has dragged the estimate far).
@@ -185,7 +187,10 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
         ``standardised``, ``estimated_error_mm`` (its misfit without it),
         ``change`` (name -> change in user units, deg / mm; None when removing
         it leaves the parameters unidentifiable), ``change_in_std`` (name ->
-        |change| / std), ``chi2_without``, ``flag``; ``flagged`` (poses, the
+        |change| / std), ``chi2_without``, ``refit_converged`` (whether the
+        refit without it converged; None for ``one-step``: where the rest of
+        the readings still do not fit, Gauss-Newton may stop after its
+        iterations wherever it is), ``flag``; ``flagged`` (poses, the
         most influential first), ``most_influential`` (pose), ``summary`` (a
         sentence naming them), ``threshold``, ``dof``, ``method``.
     """
@@ -195,12 +200,14 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
     lin = exact.linear(z, basis)
     t, lev, delta, dz = lin.per_reading()
     chi2w = np.full(lin.n, np.nan)
+    conv = [None] * lin.n
     if method == "refit":
         out = _without_each(exact, z)
         dz = out["z"] - z
         dz[~np.isfinite(out["chi2"]) | (out["dof"] <= 0) & (lin.dof <= 0)] = np.nan
-        delta = np.array([out["dropped_error_mm"][j, j] for j in range(lin.n)])
+        delta = out["dropped_error_mm"]
         chi2w = out["chi2"]
+        conv = [bool(c) for c in out["converged"]]
         # a reading the parameters need (leverage 1): its removal leaves them unidentifiable
         dz[lev > 1 - 1e-9] = np.nan
     errors = robot.errors
@@ -219,6 +226,7 @@ def deletion_diagnostics(robot, meas, result, noise=None, threshold: float = 1.0
                      "standardised": None if not np.isfinite(t[j]) else float(t[j]),
                      "estimated_error_mm": None if not np.isfinite(delta[j]) else float(delta[j]),
                      "chi2_without": None if not np.isfinite(chi2w[j]) else float(chi2w[j]),
+                     "refit_converged": conv[j],
                      "change": ({n: errors.to_user_value(n, float(v)) for n, v in zip(names, dp)} if ok else None),
                      "change_in_std": ({n: float(v) for n, v in zip(names, ratio)} if ok else None),
                      "flag": bool(score[-1] > threshold)})

@@ -1,13 +1,13 @@
 """The linearised, whitened problem of a fit check and its statistics.
 
 :class:`_Linear` is the whitened problem at the fit check's evaluation point
-(whitened residuals and Jacobian, the whitener of the data rows or its banded
-Cholesky factor, the rank of the Jacobian); :meth:`_Linear.per_reading` gives
-each reading's mean-shift statistic, leverage, estimated error and the move of
-the parameters without it.  :func:`statistics` is the chi² test and the
-per-reading statistics as the JSON-ready dict a result carries in
-``info["fit"]``.  The test, the statistics and their definitions:
-:mod:`zerocal_sym.identify.fitcheck`.
+(whitened residuals and Jacobian, the banded Cholesky factor of the data rows'
+covariance, the rank of the Jacobian); :meth:`_Linear.per_reading` gives each
+reading's mean-shift statistic, leverage, estimated error and the move of the
+parameters without it, in O(n c) time and memory (no n x n matrix).
+:func:`statistics` is the chi² test and the per-reading statistics as the
+JSON-ready dict a result carries in ``info["fit"]``.  The test, the statistics
+and their definitions: :mod:`zerocal_sym.identify.fitcheck`.
 """
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from zerocal_sym.identify import banded
 from zerocal_sym.identify.chi2 import _gamma_pq, chi2_sf
 
 #: significance level of the fit check (reject when p < alpha)
@@ -25,34 +26,23 @@ LEVERAGE_TOL = 1e-9
 RANK_RTOL = 1e-9
 
 
-def band_whitener(l, b) -> np.ndarray:
-    """``L^-1`` for the lower-bidiagonal Cholesky factor (diagonal ``l``, sub-diagonal ``b``), dense."""
-    l = np.ravel(np.asarray(l, float))
-    n = l.size
-    L = np.diag(l)
-    if n > 1:
-        L.ravel()[n::n + 1] = np.ravel(b)[: n - 1]   # the sub-diagonal
-    return np.linalg.inv(L)
-
-
 class _Linear:
     """The whitened problem at the evaluation point of a fit check.
 
     ``r`` (N,) whitened residuals, data rows first (n of them) then the prior
     rows; ``J`` (N, c) whitened Jacobian w.r.t. the fitted coordinates;
-    ``W`` (n, n) the whitener of the data rows, or None with ``band=(l, b)``,
-    the banded Cholesky factor it is the inverse of (``W`` is then built
-    only if asked for); ``poses`` (n,) the pose index k of each data row;
-    ``raw`` (n,) residuals in mm; ``basis`` (p, c) maps the fitted
-    coordinates to the scaled parameters ``z`` (``p = z / scale``).
-    ``svd``: the caller's thin SVD of ``J`` (its U may carry extra zero rows
-    below); ``terms``: the per-reading statistics ``(t, leverage, delta,
-    move)`` computed without ``W`` (``nlls_problem._fit_terms``; full column
-    rank, no prior rows).
+    ``band = (l, b)`` the lower-bidiagonal Cholesky factor of the data rows'
+    covariance (diagonal ``l`` (n,), sub-diagonal ``b`` (n-1,)) they are
+    whitened with; ``poses`` (n,) the pose index k of each data row; ``raw``
+    (n,) residuals in mm; ``basis`` (p, c) maps the fitted coordinates to the
+    scaled parameters ``z`` (``p = z / scale``).  ``svd``: the caller's thin
+    SVD of ``J`` (its U may carry extra zero rows below); ``terms``: the
+    per-reading statistics ``(t, leverage, delta, move)`` already computed
+    (``nlls_problem._fit_terms``; full column rank, no prior rows).
     """
 
-    def __init__(self, r, J, W, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None,
-                 band=None, terms=None):
+    def __init__(self, r, J, band, poses, raw, basis, scale, names, n_prior_rows=0, point=None, svd=None,
+                 terms=None):
         self.r = np.asarray(r, float)
         self.J = np.atleast_2d(np.asarray(J, float))
         self.poses = np.asarray(poses, int)
@@ -63,20 +53,14 @@ class _Linear:
         self.n = self.poses.size
         self.n_prior_rows = int(n_prior_rows)
         self.point = point
-        self._W, self._band, self._terms = (None if W is None else np.asarray(W, float)), band, terms
-        if W is None and band is None:
-            raise ValueError("_Linear needs W or band")
-        if self._W is not None:
-            w_ok = bool(np.isfinite(self._W).all())
-        else:
-            l, b = (np.ravel(np.asarray(x, float)) for x in band)
-            w_ok = bool(np.isfinite(l).all() and np.isfinite(b).all() and np.all(l != 0))
+        l, b = (np.ravel(np.asarray(x, float)) for x in band)
+        self._band, self._terms = (l, b), terms
         #: False when the exact model cannot be evaluated there (a pose is not an assembly with these errors)
-        self.valid = bool(np.isfinite(self.r).all() and np.isfinite(self.J).all() and w_ok)
+        self.valid = bool(np.isfinite(self.r).all() and np.isfinite(self.J).all() and np.isfinite(l).all()
+                          and np.isfinite(b).all() and np.all(l != 0))
         if not self.valid:
             self.r = np.where(np.isfinite(self.r), self.r, 0.0)
             self.J = np.where(np.isfinite(self.J), self.J, 0.0)
-            self._W = np.where(np.isfinite(self.W), self.W, 0.0)
             svd, self._terms = None, None
         if svd is None:
             U, s, Vt = np.linalg.svd(self.J, full_matrices=False)
@@ -91,48 +75,43 @@ class _Linear:
                                         or self.r.size != self.n):
             self._terms = None  # the terms assume full column rank and no prior rows
 
-    @property
-    def W(self) -> np.ndarray:
-        """The whitener of the data rows (n, n), dense (built on first use from ``band``)."""
-        if self._W is None:
-            try:
-                with np.errstate(all="ignore"):
-                    self._W = band_whitener(*self._band)
-            except np.linalg.LinAlgError:  # a zero on the diagonal: no whitener (the fit is not valid)
-                self._W = np.full((self.n, self.n), np.nan)
-        return self._W
-
-    def indicator(self, j) -> np.ndarray:
-        """Whitened indicator ``a`` of data row j (N,)."""
-        a = np.zeros(self.r.size)
-        a[: self.n] = self.W[:, j]
-        return a
-
     def per_reading(self, moves: bool = True):
         """``(t, leverage, delta, dz)`` for every data row: the mean-shift statistic, leverage,
         estimated error of the reading (mm) and the change of ``z`` (n, p) when the reading is removed
-        (None with ``moves=False``)."""
+        (None with ``moves=False``).
+
+        With ``a_j = [L^-1 e_j; 0]`` the whitened indicator of reading j and
+        ``H = U U^T`` the hat matrix: ``aa_j = |a_j|^2`` (the diagonal of
+        ``C^-1``), ``U^T a_j`` (row j of ``L^-T U_data``), ``a_j^T r`` (entry
+        j of ``L^-T r_data``): every term from bidiagonal solves, O(n c).
+        """
         n = self.n
-        if self._terms is not None:  # O(n p), from the banded factor (the same quantities, no n x n matrix)
+        if self._terms is not None:  # computed by the caller (the same quantities)
             t, lev, delta, move = self._terms
             t, lev, delta = np.ravel(t), np.ravel(lev), np.ravel(delta)
             dz = (self.basis @ np.reshape(move, (self.J.shape[1], n), order="F")).T if moves else None
             return t, lev, delta, dz
-        A = np.zeros((self.r.size, n))
-        A[:n] = self.W                             # column j: the whitened indicator a_j
-        aa = np.sum(A * A, axis=0)
-        UA = self.U.T @ A                          # (rank, n)
-        den = aa - np.sum(UA * UA, axis=0)         # a^T (I - H) a
-        num = A.T @ self.r - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
-        # F^+ J^T a_j: the move of the coordinates per unit error of reading j
-        Q = self.Vt.T @ (UA / self.s[:, None]) if self.rank else None
+        if not self.valid:  # nothing to test there (statistics() reports why)
+            nan = np.full(n, np.nan)
+            return nan, np.ones(n), nan.copy(), (np.full((n, self.basis.shape[0]), np.nan) if moves else None)
+        l, b = self._band
+        aa = banded.inverse_diagonal(l, b)
+        UA = banded.backward(l, b, self.U[:n]).T          # (rank, n): column j is U^T a_j
+        den = aa - np.sum(UA * UA, axis=0)                # a^T (I - H) a
+        num = banded.backward(l, b, self.r[:n]) - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
         with np.errstate(divide="ignore", invalid="ignore"):
             lev = np.where(aa > 0, 1.0 - den / aa, 1.0)
             ok = den > LEVERAGE_TOL * aa
             t = np.where(ok, num / np.sqrt(np.where(ok, den, 1.0)), np.nan)
             delta = np.where(ok, num / np.where(ok, den, 1.0), np.nan)
+        if not moves:
+            return t, lev, delta, None
         # the fit with a free error on reading j moves the coordinates by F^+ J^T a_j delta_j
-        dz = (self.basis @ (Q * delta[None, :])).T if self.rank else np.full((n, self.basis.shape[0]), np.nan)
+        if self.rank:
+            Q = self.Vt.T @ (UA / self.s[:, None])       # F^+ J^T a_j per unit error of reading j
+            dz = (self.basis @ (Q * delta[None, :])).T
+        else:
+            dz = np.full((n, self.basis.shape[0]), np.nan)
         dz[~ok] = np.nan
         return t, lev, delta, dz
 

@@ -50,6 +50,7 @@ from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, initial, prior_whitener,
                                              scaled_bounds)
+from zerocal_sym.identify.nlls_banded import round_problem
 from zerocal_sym.identify.nlls_problem import get_problem
 from zerocal_sym.identify.nlls_solve import UNIT_SIGMA_MM, information, robust_stage, solve, status_line
 from zerocal_sym.model.fastcall import FastCall
@@ -176,7 +177,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     prior_q = errors.zeros() if prior is None else _as_vector(prior, len(errors), "prior")
     scale = fisher.parameter_scale(robot, names)
     w = prior_whitener(names, prior_std, prior_cov)
-    prob = get_problem(robot, K, names)
+    prob = round_problem(robot, K, names)
     prob.touch()
     mu = errors.take(prior_q, names)
     has_prior = bool(w.any())
@@ -228,8 +229,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]
         lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
                       np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
-                      None, np.arange(1, K), s - pred, np.eye(len(names)),
-                      scale, names, len(rows), band=(l, b),
+                      (l, b), np.arange(1, K), s - pred, np.eye(len(names)),
+                      scale, names, len(rows),
                       svd=None if rows.size else svd,  # no prior rows: J's SVD is Jd's
                       terms=terms)
         at = "estimate"

@@ -12,6 +12,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from zerocal_sym.identify import banded
 from zerocal_sym.identify.fitstats import RANK_RTOL
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
@@ -85,14 +86,14 @@ def robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, 
     l, b = (np.array(o) for o in fast["weights"](z, par))
     r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
     J = np.reshape(J, (-1, z.size))
-    A = -(np.diag(l.ravel()) + np.diag(np.ravel(b), -1)) @ J[: K - 1]   # d pred / d z
+    A = -banded.times_factor(np.ravel(l), np.ravel(b), J[: K - 1])   # d pred / d z = -L J
     excl = np.asarray(robust["excluded_readings"], int) - 1
     if robust["refit_without_outliers"]:  # information of the readings kept
         keep = np.setdiff1d(np.arange(K - 1), excl)
         Jk = np.zeros((K - 1, len(names)))
-        Jk[: keep.size] = np.linalg.solve(np.linalg.cholesky(robust["_C"][np.ix_(keep, keep)]), -A[keep])
+        Jk[: keep.size] = robust["_C"].take(keep).whiten(-A[keep])
     else:  # information with the final robust weights: the data rows whitened by chol(C_w)
-        Jk = np.linalg.solve(np.linalg.cholesky(robust["_C_w"]), -A)
+        Jk = robust["_C_w"].whiten(-A)
     sol.l, sol.b, sol.r, sol.rp, sol.pred = l, b, r.ravel(), rp.ravel(), pred.ravel()
     sol.J = np.vstack([Jk, J[K - 1:]])
     return robust, A

@@ -39,6 +39,17 @@ import numpy as np
 
 #: default loss scale (standard deviations)
 DEFAULT_SCALE = {"huber": 1.345, "soft_l1": 1.0}
+#: the exact refits without one reading among which the best deletion start is taken: the readings whose
+#: linearised removal lowers chi² most
+DELETION_CANDIDATES = 8
+
+
+def lowest(values, k: int) -> np.ndarray:
+    """Bool mask of the ``k`` lowest of ``values`` (non-finite last)."""
+    v = np.asarray(values, float)
+    mask = np.zeros(v.size, bool)
+    mask[np.argsort(np.where(np.isfinite(v), v, np.inf), kind="stable")[:k]] = True
+    return mask
 
 
 def weights(loss: str, u, delta: float) -> np.ndarray:
@@ -84,10 +95,11 @@ class _Model:
         self.w = w[np.any(w != 0, axis=1)]
         self.Jp = self.w / self.scale
         self.sm2, self.sx2 = noise_terms(noise)
-        self.D = fisher.difference_matrix(self.K)
 
     def at(self, z):
-        """``(e, A, C)``: measured minus predicted changes (K-1,), ``d pred / d z`` (K-1, p), ``Cov(s)``."""
+        """``(e, A, C)``: measured minus predicted changes (K-1,), ``d pred / d z`` (K-1, p), ``Cov(s)``
+        (:class:`~zerocal_sym.identify.fisher.ChangeCovariance`, tridiagonal, as bands)."""
+        from zerocal_sym.identify.fisher import ChangeCovariance
         from zerocal_sym.model import kinematics as kin
 
         err = self.prior_q.copy()
@@ -96,8 +108,7 @@ class _Model:
         e = self.s - np.diff(rho)
         A = np.diff(de[:, self.idx], axis=0) / self.scale
         v = self.sx2 * np.sum(dt**2, axis=1)
-        C = self.sm2 * np.eye(self.K - 1) + (self.D * v) @ self.D.T
-        return e, A, C
+        return e, A, ChangeCovariance(self.sm2 + v[:-1] + v[1:], -v[1:-1])
 
     def prior_residual(self, z):
         return self.w @ (z / self.scale - self.mu)
@@ -105,10 +116,18 @@ class _Model:
 
 def conditional_residuals(e, C, infl):
     """``(c, sd)``: conditional residual of each reading given the others under ``C + diag(infl)`` and its
-    nominal conditional std (reading k's own inflation removed)."""
-    P = np.linalg.inv(C + np.diag(infl))
-    d = np.diag(P)
-    c = (P @ e) / d
+    nominal conditional std (reading k's own inflation removed).
+
+    ``C``: :class:`~zerocal_sym.identify.fisher.ChangeCovariance`; ``c = (P e) / diag(P)`` with
+    ``P = (C + diag(infl))^-1`` from its bidiagonal Cholesky factor, O(K).
+    """
+    Cw = C.plus_diagonal(infl)
+    try:
+        d = Cw.inverse_diagonal()
+    except np.linalg.LinAlgError:  # not positive definite (the model undefined there): nothing to judge by
+        nan = np.full(np.shape(e), np.nan)
+        return nan, nan.copy()
+    c = Cw.solve(e) / d
     var = 1.0 / d - infl
     return c, np.sqrt(np.maximum(var, 1e-300))
 
@@ -130,7 +149,8 @@ def irls(robot, theta_cmd, readings, names, prior_q, noise, z0, loss: str = "hub
     dict
         ``z`` (p,), ``weights`` (K-1,), ``u`` (K-1,) standardised conditional
         residuals, ``conditional_residual_mm`` (K-1,), ``C`` nominal and
-        ``C_w`` weighted covariance of the changes at ``z``, ``A`` (K-1, p),
+        ``C_w`` weighted covariance of the changes at ``z`` (tridiagonal,
+        :class:`~zerocal_sym.identify.fisher.ChangeCovariance`), ``A`` (K-1, p),
         ``e`` (K-1,), ``iterations``, ``converged``, ``objective`` (``sum rho(u_k)``
         at the end: the criterion between starts).
     """
@@ -150,9 +170,9 @@ def irls(robot, theta_cmd, readings, names, prior_q, noise, z0, loss: str = "hub
         c, sd = conditional_residuals(e, C, infl)
         om_new = weights(loss, c / sd, delta)
         infl = (1.0 / om_new - 1.0) * sd**2
-        L = np.linalg.cholesky(C + np.diag(infl))
-        rw = np.linalg.solve(L, e)
-        Jw = np.linalg.solve(L, -A)
+        Cw = C.plus_diagonal(infl)
+        rw = Cw.whiten(e)
+        Jw = Cw.whiten(-A)
         rp = mdl.prior_residual(z)
         step = -np.linalg.lstsq(np.vstack([Jw, mdl.Jp]), np.concatenate([rw, rp]), rcond=None)[0]
         z = z + step
@@ -165,8 +185,9 @@ def irls(robot, theta_cmd, readings, names, prior_q, noise, z0, loss: str = "hub
     c, sd = conditional_residuals(e, C, infl)
     u = c / sd
     om = weights(loss, u, delta)  # at the final point (max_iter = 0: the classification at z0)
-    return {"z": z, "objective": float(np.sum(loss_value(loss, u, delta))), "weights": om, "u": u, "conditional_residual_mm": c, "C": C, "C_w": C + np.diag(infl),
-            "A": A, "e": e, "iterations": it, "converged": bool(converged and np.all(np.isfinite(z)))}
+    return {"z": z, "objective": float(np.sum(loss_value(loss, u, delta))), "weights": om, "u": u,
+            "conditional_residual_mm": c, "C": C, "C_w": C.plus_diagonal(infl), "A": A, "e": e, "iterations": it,
+            "converged": bool(converged and np.all(np.isfinite(z)))}
 
 
 def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delta, w, K):
@@ -185,7 +206,7 @@ def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delt
     Returns ``(z, info, converged)``.
     """
     from zerocal_sym.identify.chi2 import chi2_sf
-    from zerocal_sym.identify.exact_refits import refits
+    from zerocal_sym.identify.leave_out import _Round, refits, without_each
     from zerocal_sym.identify.fitcheck import ROBUST_EXCLUDE_WEIGHT
     from zerocal_sym.identify.fitstats import DEFAULT_ALPHA
     from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
@@ -194,9 +215,11 @@ def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delt
     args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
     cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
     if K - 2 > len(names):
-        drop = refits(*args, [[j] for j in range(K - 1)], z_l2, prior_whitener=pw)
-        if np.any(np.isfinite(drop["chi2"])):
-            j = int(np.argmin(drop["chi2"]))
+        # the readings whose linearised removal lowers chi² most, refitted exactly
+        drop = without_each(_Round(*args, pw), [z_l2], select=lambda c, c0, d: lowest(c, DELETION_CANDIDATES))
+        chi2 = np.where(drop["refitted"], drop["chi2"], np.inf)
+        if np.any(np.isfinite(chi2)):
+            j = int(np.argmin(chi2))
             cands += [(drop["z"][j], None), (drop["z"][j], j)]
     best = None
     for z0, j in cands:
@@ -234,7 +257,6 @@ def robust_linear(robust, e, A, Jp, rp, scale, names, K):
     keep = np.setdiff1d(np.arange(K - 1), np.asarray(robust["excluded_readings"], int) - 1)
     from zerocal_sym.identify.fitstats import _Linear
 
-    C = robust["_C"][np.ix_(keep, keep)]
-    W = np.linalg.solve(np.linalg.cholesky(C), np.eye(keep.size))
-    return _Linear(np.concatenate([W @ e[keep], rp]), np.vstack([W @ -A[keep], Jp]), W, keep + 1, e[keep],
-                            np.eye(len(names)), scale, names, len(rp))
+    C = robust["_C"].take(keep)  # tridiagonal again
+    return _Linear(np.concatenate([C.whiten(e[keep]), rp]), np.vstack([C.whiten(-A[keep]), Jp]), C.cholesky(),
+                   keep + 1, e[keep], np.eye(len(names)), scale, names, len(rp))
