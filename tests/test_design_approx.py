@@ -481,3 +481,47 @@ def test_delta_reachable_cylinder_bounds(delta):
     res = design.optimize_design(delta, 8, "crlb", cons, NOISE, seed=0, n_starts=2, exchange_starts=2)
     assert design.check_design(delta, res.poses, cons) == []
     assert res.to_dict()["baseline_scheme"] == "ring scheme on the workspace"
+
+
+# ----------------------------------------------------------------- singular information, overflow
+@pytest.mark.parametrize("criterion", ["D", "A", "crlb", "E", "position"])
+def test_candidates_that_cannot_identify_are_a_design_error(robot, criterion):
+    """Twenty copies of one pose see no parameter combination: solve_measure says so (a DesignError)."""
+    X = np.repeat(design.paper_baseline(robot, 6)[:1], 20, axis=0)
+    model = posemodel.PoseModel(robot, X, NOISE, criterion)
+    with pytest.raises(DesignError, match=r"cannot identify the parameters \(singular information\)"):
+        measure.solve_measure(model, criterion)
+
+
+def test_a_measure_that_becomes_singular_is_a_design_error(robot):
+    """Candidates that barely identify the parameters (a 4 x 20 mm region): the crlb measure's active-set loop
+    reaches a singular information (it raised AttributeError there); a DesignError, and the CLI's one line."""
+    cons = design.make_constraints(robot, region=(-2, 2, 640, 660))
+    X, _ = approx.candidate_poses(robot, cons)
+    model = posemodel.PoseModel(robot, X, NOISE, "crlb")
+    with pytest.raises(DesignError, match=r"crlb measure on these candidate poses became singular: .* widen the "
+                                          r"region"):
+        measure.solve_measure(model, "crlb", tol=1e-2, certify=False)
+
+
+def test_a_measure_that_becomes_singular_is_one_line_from_the_cli(capsys, tmp_path):
+    out = tmp_path / "d.json"
+    assert main(["design", "--optimize", "--K", "6", "--region", "-2", "2", "640", "660", "--method", "approx",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "zerocal design: error: no travel window" in err and "became singular" in err
+    assert not out.exists()
+
+
+def test_e_value_far_above_its_scale_is_inf_without_overflow():
+    """E's convex form sum(pi^q) at a trial point far from the start (pi >> 1): +inf, rejected by the
+    backtracking, computed without an overflow RuntimeWarning (an error under the tests' warning filter)."""
+    rng = np.random.default_rng(0)
+    R = rng.normal(size=(12, 5))
+    w = np.full(12, 1 / 12)
+    Ninv = np.linalg.inv((R.T * w) @ R)[1:, 1:]
+    top = float(np.linalg.eigvalsh(Ninv)[-1])
+    f, st = measure._value("E", R, None, 256, w, escale=top)  # pi <= 1: the value, finite
+    assert st is not None and 0.99 < f <= 4 and f == pytest.approx(np.sum(st[3][0] ** 256))  # max pi = 1
+    f, st = measure._value("E", R, None, 256, w, escale=top / 100)  # pi up to 100: 100^256 > 1.8e308
+    assert f == math.inf and st is None

@@ -4,8 +4,12 @@ Needs the ``derive`` extra (sympy); this is the only command that imports it.
 ``--check`` writes nothing and exits 1 when the committed generated code
 differs from a fresh derivation.
 """
+import argparse
+
 NAME = "regen"
 HELP = "regenerate zerocal_sym/generated/ from derivations/ (needs sympy)"
+#: regen reads no robot file: --robot is not offered (given, it is the one-line error of cli/_checks.py)
+ROBOT_HELP = argparse.SUPPRESS
 
 
 def add_arguments(p):
