@@ -13,6 +13,7 @@ from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.paper.scheme import paper_poses
 from zerocal_sym.paper.tables import table2_errors
+from roundoff import FLOORS, estimate_floor
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +81,9 @@ def test_noise_by_name_is_the_named_model(robot, th6, R):
     one = identify_nlls(robot, Measurements(th6, R[0]), noise="scale-only")
     assert one.info["noise"] == {"sigma_scale_mm": NoiseModel.named("scale-only").sigma_scale_mm,
                                  "sigma_servo_rad": 0.0}
-    np.testing.assert_allclose(one.estimate, b.estimate[0], rtol=0, atol=1e-9)
+    # two solvers of one problem: within twice FLOORS of its round-off floor (tests/roundoff.py)
+    floor = estimate_floor(robot, th6, "paper", "scale-only", one.full_vector())
+    assert np.all(np.abs(one.estimate - b.estimate[0]) <= 2 * FLOORS * floor)
 
 
 def test_noise_names_are_the_cli_and_study_names():

@@ -116,6 +116,75 @@ def test_verdict_line(capsys, tmp_path):
     assert f"next: zerocal compensate {res} --out table.csv" in last
 
 
+def _next_commands(verdict):
+    """The commands after ``next:`` of a verdict line, as argv lists (without the leading ``zerocal``)."""
+    import shlex
+
+    cmds = [shlex.split(c) for c in verdict.split("next: ", 1)[1].split(", then ")]
+    assert all(c[0] == "zerocal" for c in cmds)
+    return [c[1:] for c in cmds]
+
+
+def test_verdict_next_command_repeats_the_run_on_the_users_robot(capsys, tmp_path, monkeypatch):
+    """Without --out the next command is identify again with --robot and every option the result depends on
+    (not the output ones), then compensate with --robot: run as printed, they give the same calibration."""
+    monkeypatch.chdir(tmp_path)
+    robot = ROOT / "examples" / "delta.toml"
+    rc, _, err = zc(capsys, "simulate", "--robot", robot, "--set", "theta1=2", "--set", "theta2=-1", "--set",
+                    "theta3=0.5", "--noise", "scale-only", "--seed", 3, "--out", "d.csv")
+    assert rc == 0, err
+    given = ["d.csv", "--robot", str(robot), "--noise", "scale-only", "--maemm-prior", "0.5", "0", "-0.25",
+             "--fit-alpha", "0.01", "--tolerance-scale", "2"]
+    rc, out, err = zc(capsys, "identify", *given, "--report", "--plot", "plots")
+    assert rc == 0, err
+    identify, compensate = _next_commands(out.strip().splitlines()[-1])
+    # the options in the parser's order, floats as Python writes them; not --report, not --plot
+    assert identify == ["identify", "d.csv", "--robot", str(robot), "--noise", "scale-only", "--maemm-prior", "0.5",
+                        "0.0", "-0.25", "--tolerance-scale", "2.0", "--fit-alpha", "0.01", "--out", "RESULT.json"]
+    assert compensate == ["compensate", "RESULT.json", "--robot", str(robot), "--out", "table.csv"]
+    rc, _, err = zc(capsys, *identify)
+    assert rc == 0, err
+    rc, first, _ = zc(capsys, "identify", *given, "--json")
+    assert json.loads(Path("RESULT.json").read_text())["zero_offsets_deg"] == json.loads(first)["zero_offsets_deg"]
+    rc, _, err = zc(capsys, *compensate)
+    assert rc == 0 and Path("table.csv").exists(), err
+    # with --out the next command is compensate on that file, --robot kept
+    rc, out, err = zc(capsys, "identify", *given, "--out", "r.json")
+    assert rc == 0, err
+    assert _next_commands(out.strip().splitlines()[-1]) == [["compensate", "r.json", "--robot", str(robot), "--out",
+                                                             "table.csv"]]
+
+
+def test_verdict_judges_sigma_against_the_largest_offset_or_the_goal(capsys, tmp_path):
+    """A true offset near zero does not make a good result "NOT small": 1 sigma is judged against the largest
+    |offset| (10 % of it), or against --goal-deg when given."""
+    data = tmp_path / "d.csv"
+    rc, _, err = zc(capsys, "simulate", "--set", "theta1=2", "--set", "theta2=0.01", "--n", 6, "--noise",
+                    "scale-only", "--seed", 1, "--out", data)
+    assert rc == 0, err
+
+    def verdict(*extra):
+        rc, out, err = zc(capsys, "identify", data, "--noise", "scale-only", *extra)
+        assert rc == 0, err
+        return out.strip().splitlines()[-1]
+
+    v = verdict()
+    sigma = float(v.split("offsets' 1 sigma ")[1].split(",")[0])
+    assert 0.01 < sigma < 0.2  # above |theta2|, far below 10 % of theta1
+    assert "small against the offsets (<= 0.1 x the largest |offset|, 1.9" in v and "NOT" not in v
+    assert "within the goal 0.2 deg" in verdict("--goal-deg", "0.2")
+    v = verdict("--goal-deg", "0.01")
+    assert "NOT within the goal 0.01 deg; measure more poses" in v and "--goal-deg 0.01" in v
+    # and a result whose 1 sigma is large against every offset still says so
+    small = tmp_path / "s.csv"
+    rc, _, err = zc(capsys, "simulate", "--set", "theta1=0.05", "--set", "theta2=-0.02", "--n", 6, "--noise",
+                    "scale-only", "--seed", 1, "--out", small)
+    assert rc == 0, err
+    rc, out, err = zc(capsys, "identify", small, "--noise", "scale-only")
+    assert rc == 0, err
+    assert "NOT small against the offsets (> 0.1 x the largest |offset|" in out.strip().splitlines()[-1]
+
+
 def test_identify_reports_the_bias_from_the_omitted_errors(capsys, tmp_path):
     """issue 13: identify states the bias its estimate may carry from the errors left out, within their tolerances."""
     data = simulate(capsys, tmp_path / "d.csv", "--noise", "scale-only")

@@ -34,26 +34,56 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """A command's docstring as written; each option's default in its help, unless the help states it already
+    (or there is none to state: ``None``, an unset flag)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if (not action.option_strings or "default" in text or action.default is None or action.default is False
+                or action.default is argparse.SUPPRESS or action.default == []):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
 def _command_modules():
     pkg = importlib.import_module(__name__)
     names = sorted(m.name for m in pkgutil.iter_modules(pkg.__path__) if m.name.startswith("cmd_"))
     return [importlib.import_module(f"{__name__}.{n}") for n in names]
 
 
+#: the help of ``--robot`` in a command that takes any mechanism; a command module's ``ROBOT_HELP`` replaces it
+#: (``argparse.SUPPRESS``: the option is hidden, and giving it is that command's one-line error, cli/_checks.py)
+ROBOT_HELP = ("robot TOML file, any mechanism (default: the paper's robot, Table 1; examples/delta.toml: the "
+              "rotary Delta)")
+
+
+def version() -> str:
+    """The installed package's version (its metadata), or the source's when it is not installed."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as dist_version
+
+    try:
+        return dist_version("zerocal_sym")
+    except PackageNotFoundError:
+        from zerocal_sym import __version__
+
+        return __version__
+
+
 def build_parser() -> argparse.ArgumentParser:
     from zerocal_sym.cli._paths import InputFile, path_options
 
-    common = _Parser(add_help=False)
-    common.add_argument("--robot", metavar="FILE", default=None, type=InputFile("the robot file"),
-                        help="robot TOML file, any mechanism (default: the paper's robot, Table 1; "
-                             "examples/delta.toml: the rotary Delta)")
     parser = _Parser(
         prog="zerocal",
         description="Zero-offset calibration of parallel robots (Mei et al. 2017, and beyond).")
+    parser.add_argument("--version", action="version", version=f"zerocal {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for mod in _command_modules():
-        p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.__doc__, parents=[common],
-                           formatter_class=argparse.RawDescriptionHelpFormatter)
+        p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.__doc__,
+                           formatter_class=_HelpFormatter)
+        p.add_argument("--robot", metavar="FILE", default=None, type=InputFile("the robot file"),
+                       help=getattr(mod, "ROBOT_HELP", ROBOT_HELP))
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run, _paths=path_options(p))  # the files it reads and writes (cli/_paths.py)
     return parser

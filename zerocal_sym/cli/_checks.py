@@ -168,6 +168,8 @@ def _prior_within_plausible(args) -> None:
 
 def _identify(args) -> None:
     _trust(args)
+    _positive(args, "goal_deg", " of degrees")
+    _positive(args, "goal", " (in the joints' unit)")
     if args.method == "tsvd":
         bad = _given(args, "params", "prior_std", "bound", "max_iter")
         if bad:

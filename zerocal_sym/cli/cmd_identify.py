@@ -32,6 +32,10 @@ HELP = "identify zero offsets and MAEMM from a measurement file (Ipopt or TSVD)"
 
 #: the files ``--plot DIR`` writes into DIR
 PLOTS = ("residuals.png", "boundary_errors.png")
+#: without --goal-deg, the offsets' 1 sigma is small when at most this fraction of the largest |offset|
+SIGMA_FRACTION = 0.1
+#: identify's options that change only what is written, not the result nor the verdict: not in the next command
+_OUTPUT_ONLY = ("json", "out", "plot", "report")
 
 
 def add_arguments(p):
@@ -69,6 +73,12 @@ def add_arguments(p):
     p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
                    help="tolerances by name (TOML or JSON)")
     p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S", help="every tolerance times S")
+    p.add_argument("--goal", type=float, default=None, metavar="X",
+                   help="the accuracy you need, in the joints' unit (deg for revolute, mm for prismatic joints): the "
+                        "verdict line judges the offsets' 1 sigma against it (default: against "
+                        f"{SIGMA_FRACTION:g} x the largest |offset|)")
+    p.add_argument("--goal-deg", type=float, default=None, metavar="DEG",
+                   help="the same for revolute joints, in deg")
     p.add_argument("--json", action="store_true", help="print the results JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="write the results JSON here")
     p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
@@ -134,8 +144,10 @@ def diagnosis(res) -> str:
     return (fit or {}).get("diagnosis") or ""
 
 
-def offsets_sigma_text(res) -> str:
-    """The offsets' 1 sigma and whether it is small against the offsets."""
+def offsets_sigma_text(res, goal=None) -> str:
+    """The offsets' 1 sigma and whether it is small: against ``goal`` (``--goal``, in the offsets' unit: deg or
+    mm; ``--goal-deg`` for revolute joints) when given, else against the offsets' scale, the largest |offset|
+    (one scale for all: an offset near zero is no reason to measure more)."""
     import numpy as np
 
     off = np.abs(np.asarray(res.zero_offsets_user, float))
@@ -143,13 +155,19 @@ def offsets_sigma_text(res) -> str:
     if not np.all(np.isfinite(std)):
         return "offsets' 1 sigma not available"
     s = ", ".join(f"{x:.3g}" for x in std)
-    big = float(np.max(off)) if off.size else 0.0
-    small = bool(np.all(std <= 0.1 * np.maximum(off, 1e-12))) or float(np.max(std)) < 0.01
     kind = f" ({res.std_kind})" if getattr(res, "std_kind", None) else ""
+    worst = float(np.max(std))
     u = getattr(res, "offset_unit", "deg")
-    return (f"offsets' 1 sigma {s} {u}{kind}: "
-            + ("small against the offsets" if small else
-               f"NOT small against the offsets (largest |offset| {big:.3g} {u}); measure more poses"))
+    if goal is not None:
+        verdict = (f"within the goal {goal:g} {u}" if worst <= goal else
+                   f"NOT within the goal {goal:g} {u}; measure more poses")
+    else:
+        scale = float(np.max(off)) if off.size else 0.0
+        verdict = (f"small against the offsets (<= {SIGMA_FRACTION:g} x the largest |offset|, {scale:.3g} {u})"
+                   if worst <= SIGMA_FRACTION * scale else
+                   f"NOT small against the offsets (> {SIGMA_FRACTION:g} x the largest |offset|, {scale:.3g} {u}); "
+                   "measure more poses, or state the accuracy you need with --goal")
+    return f"offsets' 1 sigma {s} {u}{kind}: {verdict}"
 
 
 def _parse_named(items, robot, names, what, parse):
@@ -384,6 +402,44 @@ def verdict_line(res, args) -> str:
         why = f"accepted: fit p-value {p:.3g} >= {fit.get('alpha', args.fit_alpha):g}"
     else:
         why = f"accepted: fit not checked ({fit.get('reason') or 'no spare degree of freedom'})"
-    nxt = (f"zerocal compensate {args.out} --out table.csv" if args.out else
-           f"zerocal identify {args.data} --out RESULT.json, then zerocal compensate RESULT.json --out table.csv")
-    return f"verdict: {why}; {offsets_sigma_text(res)}; next: {nxt}"
+    robot = ["--robot", args.robot] if getattr(args, "robot", None) else []
+    compensate = _command("compensate", args.out or "RESULT.json", *robot, "--out", "table.csv")
+    nxt = (compensate if args.out else
+           f"{_command('identify', *repeat_options(args), '--out', 'RESULT.json')}, then {compensate}")
+    goal = getattr(args, "goal", None)
+    goal = goal if goal is not None else getattr(args, "goal_deg", None)
+    return f"verdict: {why}; {offsets_sigma_text(res, goal)}; next: {nxt}"
+
+
+def _command(*words) -> str:
+    import shlex
+
+    return "zerocal " + " ".join(shlex.quote(str(w)) for w in words)
+
+
+def repeat_options(args) -> list:
+    """The data file and every option given but the output ones (:data:`_OUTPUT_ONLY`): ``--robot``,
+    ``--method``, ``--noise``, priors, bounds, tolerances, the fit check's, ``--goal-deg``, as words (floats as
+    Python writes them, digit for digit): ``identify`` with them repeats this run."""
+    import argparse
+
+    from zerocal_sym.cli import build_parser
+    from zerocal_sym.cli._checks import _given
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices[NAME]
+    words = [args.data]
+    for a in sub._actions:
+        if (not a.option_strings or a.dest in _OUTPUT_ONLY or a.default is argparse.SUPPRESS
+                or not _given(args, a.dest)):
+            continue
+        value, opt = getattr(args, a.dest), a.option_strings[0]
+        if a.nargs == 0:  # a flag
+            words.append(opt)
+        elif isinstance(a, argparse._AppendAction):
+            for v in value:
+                words += [opt, v]
+        elif isinstance(value, (list, tuple)):
+            words += [opt, *value]
+        else:
+            words += [opt, value]
+    return [str(w) for w in words]

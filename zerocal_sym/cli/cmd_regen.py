@@ -14,8 +14,12 @@ to choose), and a robot file names it with ``mechanism_module``
 (docs/new-mechanism.md).  Its inputs hash covers the file and the installed
 ``derivations/mechanism.py`` and ``derivations/codegen.py``.
 """
+import argparse
+
 NAME = "regen"
 HELP = "regenerate the generated code from the sympy derivations (needs sympy)"
+#: regen reads no robot file: --robot is not offered (given, it is the one-line error of cli/_checks.py)
+ROBOT_HELP = argparse.SUPPRESS
 
 
 def add_arguments(p):

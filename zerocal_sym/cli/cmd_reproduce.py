@@ -18,6 +18,8 @@ it is an error -- run ``simulate``/``identify``/``compare --set`` there.
 """
 NAME = "reproduce"
 HELP = "run Table 2's six groups through the loop; Tables 3-6 and Figs. 8-9 vs the paper"
+ROBOT_HELP = ("robot TOML file of the paper's planar 2-DOF mechanism, the one whose source errors Table 2 gives "
+              "(default: the paper's robot, Table 1, as examples/paper_robot.toml)")
 
 
 #: the files ``--out DIR`` writes into DIR
@@ -48,18 +50,15 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print the results as JSON")
 
 
-def _progress(total):
-    import sys
-    import time
+def _progress(total, stream=None):
+    """``report(done, total)`` for :func:`reproduce`: a bar on a terminal; in a log or a pipe a line at each
+    quarter (four at most)."""
+    from zerocal_sym.identify.progress import Progress
 
-    t0 = time.perf_counter()
-    state = {"t0": t0, "last": t0}
+    bar = Progress(total, "reproduce", stream=stream, unit="loop", every_pct=25)
 
     def report(done, _total):
-        now = time.perf_counter()
-        if done == total or now - state["last"] > 0.5:
-            state["last"] = now
-            print(f"reproduce: {done}/{total} loops, {now - state['t0']:.1f} s", file=sys.stderr, flush=True)
+        bar(done)
 
     return report
 

@@ -292,6 +292,7 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     p = model.aq.shape[1]
     exact, enlarged = _windows(model.rho, cons)
     iters = 0
+    refused = []  # why a window had no measure (solve_measure's DesignError)
 
     def solve_in(mod, win, w0=None, tol_=tol, certify=True):
         idx = np.flatnonzero((mod.rho >= win[0]) & (mod.rho <= win[1]))
@@ -300,7 +301,8 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         sub = mod.subset(idx)
         try:
             sol = solve_measure(sub, criterion, None if w0 is None else w0[idx], tol_, certify=certify)
-        except DesignError:
+        except DesignError as exc:
+            refused.append(str(exc))
             return idx, None
         return idx, sol
 
@@ -317,7 +319,8 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         if best is None or user_loss(sol) < user_loss(best[2]):
             best = (win, idx, sol)
     if best is None:
-        raise DesignError("no travel window of the candidate poses can identify the parameters")
+        why = f" ({refused[-1]})" if refused else ""
+        raise DesignError(f"no travel window of the candidate poses can identify the parameters{why}")
     win, idx, sol = best
     # refine the support of the chosen window
     for r in range(refine):

@@ -21,12 +21,14 @@ import math
 import numpy as np
 
 from zerocal_sym.design.limits import DesignError
-from zerocal_sym.design.posemodel import E_Q, PoseModel, _evaluate, _exponent, _sens
+from zerocal_sym.design.posemodel import E_Q, PoseModel, _evaluate, _exponent, _schur, _sens, _stats
 
 #: default target efficiency gap of the measure (efficiency lower bound >= 1 - TOL)
 TOL = 1e-4
 #: active-set sizes of :func:`solve_measure`: support points kept, violators added per round
 MAX_ACTIVE, MAX_ADD = 60, 20
+#: log of the largest float: a value above it is +inf (:func:`_value`)
+_LOG_MAX = math.log(np.finfo(float).max)
 
 
 def _regressors(aq, vt):
@@ -37,7 +39,9 @@ def _regressors(aq, vt):
 def _value(criterion, R, W, q, w, escale=None):
     """The convex form's value at ``w`` (:func:`_fgh`) and the factors its derivatives reuse.
 
-    Returns ``(f, st)``, ``st`` None (and ``f`` inf) when ``N`` is not positive definite.  The
+    Returns ``(f, st)``, ``st`` None (and ``f`` inf) when ``N`` is not positive definite, or for E
+    when the value overflows (``pi`` far above 1: a trial point far from the start, which the
+    backtracking rejects; computed, ``pi ** q`` would overflow with a RuntimeWarning).  The
     backtracking of :func:`_restricted` needs the value alone.  Keep the arithmetic as it is,
     operation for operation (and that of :func:`_grad_hess`): near the optimum the solver's
     accept/reject decisions compare values that differ by round-off, so an equivalent but
@@ -56,6 +60,8 @@ def _value(criterion, R, W, q, w, escale=None):
         return float(np.sum(W * Ninv[1:, 1:])), (N, L, Ninv, None)
     pi, V = np.linalg.eigh(Ninv[1:, 1:] / escale)
     pi = np.maximum(pi, 0)
+    if pi[-1] > 1 and q * math.log(pi[-1]) > _LOG_MAX - math.log(len(pi)):  # sum(pi ** q) > the largest float
+        return math.inf, None
     return float(np.sum(pi ** q)), (N, L, Ninv, (pi, V))
 
 
@@ -231,16 +237,25 @@ def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, 
     w = w / w.sum()
     qs = [q] if criterion != "E" else [qq for qq in (4, 16, 64) if qq < q] + [q]
     rounds = 0
+
+    def evaluate(qq, first):
+        out = _evaluate(criterion, W, qq, w, aq, vt)
+        if out[1] is None:  # a singular information matrix: no criterion value, no derivative
+            if first:
+                raise DesignError("the candidate poses cannot identify the parameters (singular information)")
+            raise DesignError(f"the {criterion} measure on these candidate poses became singular: they barely "
+                              f"identify the parameters, condition {_condition(aq, vt):.2g} at equal weights; "
+                              "widen the region")
+        return out
+
     for qq in qs:
         lam = _exponent(criterion, qq)
-        for _ in range(30):  # multiplicative steps: the rough support
-            loss, grad, d, s, M, c = _evaluate(criterion, W, qq, w, aq, vt)
-            if grad is None:
-                raise DesignError("the candidate poses cannot identify the parameters (singular information)")
+        for it in range(30):  # multiplicative steps: the rough support
+            loss, grad, d, s, M, c = evaluate(qq, first=it == 0 and qq == qs[0])
             w = w * np.maximum(d / s, 0) ** lam
             w /= w.sum()
         for _ in range(max_rounds):
-            loss, grad, d, s, M, c = _evaluate(criterion, W, qq, w, aq, vt)
+            loss, grad, d, s, M, c = evaluate(qq, first=False)
             eff = s / d.max()
             if eff >= 1 - tol:
                 break
@@ -252,13 +267,20 @@ def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, 
             wa = w[act] + 1e-3 / len(act)
             w = np.zeros(N)
             w[act] = _restricted(criterion, W, qq, _regressors(aq[act], vt[act]), wa / wa.sum())
-    loss, grad, d, s, M, c = _evaluate(criterion, W, qs[-1], w, aq, vt)
+    loss, grad, d, s, M, c = evaluate(qs[-1], first=False)
     out = {"w": w, "M": M, "c": c, "d": d, "loss": loss, "s": s, "iterations": rounds, "q": qs[-1]}
     if criterion == "E":  # the E-certificate (a small optimisation) only when asked; else the smooth one's
         out["eff_lb"], out["E_bound"] = e_certificate(model, M, c) if certify else (float(s / d.max()), None)
     else:
         out["eff_lb"] = float(s / d.max())
     return out
+
+
+def _condition(aq, vt):
+    """Condition number of the information of the equal-weight measure on the candidates ``aq`` (N, p)."""
+    M, _ = _schur(*_stats(np.full(len(vt), 1.0 / len(vt)) / vt, aq))
+    ev = np.linalg.eigvalsh(M)
+    return float(ev[-1] / ev[0]) if ev[0] > 0 else math.inf
 
 
 def e_certificate(model: PoseModel, M, c):
