@@ -20,7 +20,8 @@ Tolerances
   at most 10 times the page's; the last digits of rounding errors differ
   between two implementations of the same arithmetic;
 * a Monte Carlo figure (``monte_carlo``): the page's range widened by three
-  sampling standard deviations of our trial count.
+  standard deviations of the difference of two Monte Carlo estimates, ours
+  from the trials asked for and the page's from its 1000.
 """
 from __future__ import annotations
 
@@ -33,6 +34,9 @@ import numpy as np
 
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.noise import geometry_error
+
+#: the page's Monte Carlo trials per case
+PAGE_TRIALS = 1000
 
 
 def decimals(text: str) -> int:
@@ -84,20 +88,20 @@ class Page:
         ours_v = np.atleast_1d(np.asarray(ours, float))
         if ours_v.size != len(texts):
             return self.line(False, what, fmt(ours), ", ".join(texts), f"{len(texts)} values expected")
-        ok, off = True, []
+        ok, shown, off = True, [], False
         for o, t in zip(ours_v, texts):
             v, dec = page_float(t), decimals(t)
             tol = max(rel * abs(v), 0.5 * 10.0**-dec)
             ok &= bool(abs(o - v) <= tol)
-            shown = f"{o:.{dec}f}"
-            if page_float(shown) != v and not (page_float(shown) == 0 and v == 0):
-                off.append(shown)
+            shown.append(f"{o:.{dec}f}".replace("-0." + "0" * dec, "0." + "0" * dec) if dec else f"{o:.0f}")
+            off |= page_float(shown[-1]) != v
         theirs = texts[0] if len(texts) == 1 else "(" + ", ".join(texts) + ")"
         tol = (f"relative {rel:.0%}, or half a unit of the page's last digit where coarser"
-               + (f"; to the page's digits ours is ({', '.join(off)}): the last digit differs" if off else ""))
+               + (f"; to the page's digits ours is ({', '.join(shown)}): the last digit differs" if off else ""))
         if off:
             self.last_digit.append(what)
-        return self.line(ok, what, fmt(ours_v if ours_v.size > 1 else ours_v[0]), theirs, tol)
+        printed = [f"{o:.{decimals(t) + 2}f}" for o, t in zip(ours_v, texts)]  # two digits beyond the page's
+        return self.line(ok, what, printed[0] if len(printed) == 1 else "(" + ", ".join(printed) + ")", theirs, tol)
 
     def exact(self, what: str, ours, page) -> bool:
         """Equal (counts, ranks, shapes, lists)."""
@@ -118,15 +122,19 @@ class Page:
         return self.line(bool(ours <= bound), what, f"{ours:.2g}", page,
                          f"rounding-error level: at most 10x the page's, {bound:.2g}")
 
-    def monte_carlo(self, what: str, ours, lo: float, hi: float, sd: float, trials: int, page_trials: int,
-                    theirs: str) -> bool:
-        """Monte Carlo figures: in the page's range ``[lo, hi]`` widened by 3 ``sd`` (our trial count's sampling
-        standard deviation of one figure)."""
+    def monte_carlo(self, what: str, ours, lo: float, hi: float, sd, trials: int, theirs: str,
+                    page_trials: int = PAGE_TRIALS) -> bool:
+        """Monte Carlo figures against the page's range ``[lo, hi]`` (or its one figure, ``lo = hi``).
+
+        ``sd(N)`` is the sampling standard deviation of one such figure from N trials.  Ours (``trials``)
+        and the page's (``page_trials``) are independent samples: a difference has the standard deviation
+        ``sqrt(sd(trials)^2 + sd(page_trials)^2)``; the range is widened by 3 of those.
+        """
         v = np.atleast_1d(np.asarray(ours, float))
-        a, b = lo - 3 * sd, hi + 3 * sd
-        return self.line(bool(np.all((v >= a) & (v <= b))), what, fmt(v, 3), theirs,
-                         f"{trials} trials (the page: {page_trials}): the page's range widened by 3 x {sd:.3f}, "
-                         f"our sampling std: [{a:.3f}, {b:.3f}]")
+        s = math.hypot(sd(trials), sd(page_trials))
+        a, b = lo - 3 * s, hi + 3 * s
+        return self.line(bool(np.all((v >= a) & (v <= b))), what, fmt(v if v.size > 1 else v[0], 3), theirs,
+                         f"{trials} trials, the page {page_trials}: widened by 3 x {s:.3f}: [{a:.3f}, {b:.3f}]")
 
     # ------------------------------------------------------------------ the end
     def exit_code(self) -> int:
@@ -142,14 +150,37 @@ def rms_ratio_sd(trials: int) -> float:
     return 1.0 / math.sqrt(2.0 * trials)
 
 
+def chi2_mean_sd(dof: int):
+    """``N -> `` the sampling std of the mean of N chi-square(``dof``) values: ``sqrt(2 dof / N)``."""
+    return lambda trials: math.sqrt(2.0 * dof / trials)
+
+
+def monte_carlo_note(trials: int, what: str, chi2: bool = False) -> None:
+    """Say how the Monte Carlo checks' tolerances come about."""
+    Page.note(f"Monte Carlo, {what}; {trials} trials per case (the page: {PAGE_TRIALS}).  An RMS/CRLB from N "
+              f"trials has a sampling std of 1/sqrt(2N) ({rms_ratio_sd(trials):.3f} here, "
+              f"{rms_ratio_sd(PAGE_TRIALS):.3f} for the page's)"
+              + (", a mean of e^T F e (chi-square, p degrees of freedom) sqrt(2p/N)" if chi2 else "")
+              + "; ours and the page's are independent samples, so each check allows 3 standard deviations of "
+              "their difference around the page's range")
+
+
 def arguments(doc: str, trials: int) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=doc.splitlines()[0])
     p.add_argument("--trials", type=int, default=trials,
-                   help=f"Monte Carlo trials per case (default {trials}; the page's figures came from 1000)")
+                   help=f"Monte Carlo trials per case (default {trials}; the page's figures came from {PAGE_TRIALS})")
+    p.add_argument("--seed", type=int, default=None,
+                   help="another set of random draws: trial t of case c uses default_rng([seed, c, t]) "
+                        "(default: default_rng([c, t]))")
     args = p.parse_args()
     if args.trials < 10:
         p.error("--trials: at least 10")
     return args
+
+
+def trial_rng(seed, case: int, trial: int) -> np.random.Generator:
+    """The random draws of one trial: ``default_rng([case, trial])``, or ``[seed, case, trial]`` with a seed."""
+    return np.random.default_rng([case, trial] if seed is None else [seed, case, trial])
 
 
 # ---------------------------------------------------------------------- the Jacobian against central differences
