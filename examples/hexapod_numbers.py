@@ -1,6 +1,6 @@
 """Recompute every number the hexapod's model page (docs/hexapod.md) reports as measured, and check it.
 
-Run:  python examples/hexapod_numbers.py [--trials N]
+Run:  python examples/hexapod_numbers.py [--trials N] [--seed S]
 
 Each number is printed as ``ok  <what>: <ours> (page: <theirs>)  [tolerance]`` or ``BAD ...``; the exit
 status is 1 if any is BAD.  The page's figures came from an implementation independent of zerocal_sym;
@@ -197,26 +197,17 @@ def weighted_gauss_newton(robot, th, readings, names, noise, tol=1e-11, max_iter
     raise RuntimeError("Gauss-Newton did not converge")
 
 
-def main():
-    args = arguments(__doc__, trials=100)
-    robot = load_robot(ROBOT)
-    errors = robot.errors
-    geo = Geometry(robot)
+def legs_and_stroke(robot, draws):
+    """Home, the legs over the corners and random poses, the local optima, the stroke."""
     ws = robot.workspace
-    noise_both = robot.noise
-    noise_scale = NoiseModel.named("scale-only", robot)
-    print(f"robot: {ROBOT.name}; noise: scale {noise_both.sigma_scale_mm} mm, legs {noise_both.sigma_joint} mm")
-
-    # ---------------------------------------------------------------- home, leg ranges, stroke
+    lo, hi = robot.workspace_bounds()
     home = robot.home_joints()
     page.value("home leg lengths (mm)", home, ["339.026"] * 6)
     corners = ws.boundary_scheme(64)
     Lc = kin.ik(robot, corners)
     page.value("legs over the 64 corners (mm)", [Lc.min(), Lc.max()], ["232.420", "461.725"])
     page.value("  against home (mm)", [Lc.min() - home[0], Lc.max() - home[0]], ["-106.61", "+122.70"])
-    rng = np.random.default_rng(2017)
-    lo, hi = robot.workspace_bounds()
-    X = lo + rng.uniform(size=(200_000, 6)) * (hi - lo)
+    X = lo + draws.uniform(size=(200_000, 6)) * (hi - lo)
     LX = kin.ik(robot, X, check=False)
     page.exact("200,000 random poses in the box go no further than the corners",
                bool(LX.min() >= Lc.min() and LX.max() <= Lc.max()), True)
@@ -252,11 +243,16 @@ def main():
                    and np.sum(excess[k] > 0) == 1 for k in over), True)
     page.value("  how much more than the stroke they need (mm)",
                [excess[over].max(axis=1).min(), excess[over].max()], ["0.52", "2.70"])
-    page.exact("stroke +-125 mm holds the whole box (corners and the random poses)",
-               bool(np.max(np.abs(Lc - home)) <= 125 and np.max(np.abs(LX - home)) <= 125), True)
+    stroke = robot.param("stroke")
+    page.exact(f"the robot file's stroke +-{stroke:g} mm holds the whole box (corners and the random poses)",
+               bool(np.max(np.abs(Lc - home)) <= stroke and np.max(np.abs(LX - home)) <= stroke), True)
 
-    # ---------------------------------------------------------------- forward kinematics
-    poses = np.vstack([corners, ws.grid(3), lo + rng.uniform(size=(3000, 6)) * (hi - lo)])
+
+def forward_kinematics(robot, geo, draws):
+    """FK(IK(pose)) over the corners, the 3^6 grid and random poses; Newton's steps; the leg Jacobian."""
+    ws = robot.workspace
+    lo, hi = robot.workspace_bounds()
+    poses = np.vstack([ws.boundary_scheme(64), ws.grid(3), lo + draws.uniform(size=(3000, 6)) * (hi - lo)])
     th = kin.ik(robot, poses)
     back = kin.fk(robot, th)
     page.roundoff("FK(IK(pose)) over the corners, the 3^6 grid and 3000 random poses: position error (mm)",
@@ -274,13 +270,18 @@ def main():
               + fmt(res_page.max(axis=0), 2) + "; zerocal_sym's (roll, pitch, yaw) " + fmt(res_ours.max(axis=0), 2))
     page.exact(f"  Newton iterations to a leg residual below {tol:g} mm, the page's rotation update (most over "
                "the poses)", iterations_to(res_page.max(axis=0), tol), 5)
-    page.exact("  the same for zerocal_sym's steps in roll, pitch, yaw (" + robot.mechanism.module._fk.__doc__.split(
-        " on ")[0].lower() + " in the generated FK)", iterations_to(res_ours.max(axis=0), tol), 5)
+    page.exact("  the same for zerocal_sym's Newton steps in roll, pitch, yaw (the generated fk_residual)",
+               iterations_to(res_ours.max(axis=0), tol), 5)
     conds = np.linalg.cond(leg_matrix(geo, poses[:, :3], rotations(poses), 100.0)[0])
     page.value("leg Jacobian (rotation columns at 100 mm): largest cond over those poses", conds.max(), "5.21")
 
-    # ---------------------------------------------------------------- identifiability
-    th80 = kin.ik(robot, lo + rng.uniform(size=(80, 6)) * (hi - lo))
+
+def identifiability(robot, geo, draws):
+    """Ranks and null spaces at 80 random poses and the corners; the weakest direction at the corners."""
+    errors = robot.errors
+    lo, hi = robot.workspace_bounds()
+    Lc = kin.ik(robot, robot.workspace.boundary_scheme(64))
+    th80 = kin.ik(robot, lo + draws.uniform(size=(80, 6)) * (hi - lo))
     rep = idf.identifiability_report(robot, th80, "all")
     page.exact("all 48 source errors, 80 random poses: rank", rep["rank"], 36)
     page.exact("  its null space is the declared gauge (12 rigid motions)", rep["null_space_rigid"], True)
@@ -308,15 +309,23 @@ def main():
     page.exact("default set (dL, drM, dd): rank of 12 at 80 random poses and at the 64 corners",
                (idf.identifiability_report(robot, th80, "default")["rank"],
                 idf.identifiability_report(robot, Lc, "default")["rank"]), (12, 12))
-    G, _ = identification_matrix(robot, corners)
+    G, _ = identification_matrix(robot, robot.workspace.boundary_scheme(64))
     weak = np.linalg.svd(G)[2][-1]
     weak = weak * np.sign(weak[errors.default.index("L3")])
     page.value("  weakest direction of G at the corners: dL1..6, drMz (unit vector)",
                np.append(weak[:6], weak[errors.default.index("rMz")]),
                ["0.24", "0.21", "0.59", "0.58", "-0.20", "-0.15", "-0.34"])
 
-    # ---------------------------------------------------------------- the corner scheme
-    page.value("corner scheme (64): cond(G), G in mm", condition_number(G), "138.8")
+
+def corner_schemes(robot, noise_both, noise_scale):
+    """The 64 corners, the first 16 of them, and the 2^(6-2) fraction: cond(G), CRLB, null directions."""
+    errors = robot.errors
+    ws = robot.workspace
+    lo, hi = robot.workspace_bounds()
+    corners = ws.boundary_scheme(64)
+    Lc = kin.ik(robot, corners)
+    page.value("corner scheme (64): cond(G), G in mm", condition_number(identification_matrix(robot, corners)[0]),
+               "138.8")
     page.value("  CRLB of dL1..6, scale only (mm)", fisher.crlb_zero_offsets_user(robot, Lc, "default", noise_scale),
                ["0.01327", "0.01317", "0.01637", "0.01716", "0.01561", "0.01367"])
     page.value("  CRLB of dL1..6, scale + legs (mm)", fisher.crlb_zero_offsets_user(robot, Lc, "default", noise_both),
@@ -350,7 +359,10 @@ def main():
     page.exact("  holding ddx known: rank of 11",
                idf.identifiability_report(robot, first16, [n for n in errors.default if n != "ddx"])["rank"], 11)
     frac = ws.boundary_scheme(16)
-    bit = lambda P, j: np.isclose(P[:, j], hi[j]).astype(int)  # noqa: E731
+
+    def bit(P, j):
+        return np.isclose(P[:, j], hi[j]).astype(int)
+
     page.exact("the 2^(6-2) fraction: pitch bit = x^y^z, yaw bit = y^z^roll",
                bool(np.all(bit(frac, 4) == bit(frac, 0) ^ bit(frac, 1) ^ bit(frac, 2))
                     and np.all(bit(frac, 5) == bit(frac, 1) ^ bit(frac, 2) ^ bit(frac, 3))), True)
@@ -362,7 +374,11 @@ def main():
         c = fisher.crlb_zero_offsets_user(robot, thf, "default", noise)
         page.value(f"  CRLB range of dL1..6 ({label})", [c.min(), c.max()], want)
 
-    # ---------------------------------------------------------------- noise-free identification, 64 corners
+
+def identification(robot, trials, seed, noise_both, noise_scale):
+    """Noise-free recovery, one linear step, the Jacobian, the Monte Carlo: all on the 64 corners."""
+    errors = robot.errors
+    Lc = kin.ik(robot, robot.workspace.boundary_scheme(64))
     truth = errors.assemble(zero_offsets_user=(0.3, -0.2, 0.1, 0.25, -0.15, 0.05),
                             maemm_mm=(0.1, -0.1, 0.05, 0.05, 0.0, -0.05))
     names = errors.resolve("default")
@@ -385,13 +401,13 @@ def main():
                   "differences (step 1e-3 mm), relative", rel, "1.4e-9")
 
     # ---------------------------------------------------------------- Monte Carlo
-    monte_carlo_note(args.trials, "64 corners, the truth of the noise-free case; weighted Gauss-Newton on the exact "
+    monte_carlo_note(trials, "64 corners, the truth of the noise-free case; weighted Gauss-Newton on the exact "
                      "model (this script's loop: identify_nlls takes seconds per data set here)", chi2=True)
     for case, (noise, lo_r, hi_r, chi, label) in enumerate(((noise_both, 0.97, 1.04, 12.15, "both noises"),
                                                             (noise_scale, 1.02, 1.05, 12.28, "scale only"))):
         E = []
-        for trial in range(args.trials):
-            readings = plant.measure(Lc, noise, trial_rng(args.seed, case, trial))
+        for trial in range(trials):
+            readings = plant.measure(Lc, noise, trial_rng(seed, case, trial))
             est = weighted_gauss_newton(robot, Lc, readings, names, noise)
             if case == 0 and trial == 0:
                 ref = identify_nlls(robot, Measurements(theta_cmd=Lc, readings=readings), "default", noise=noise,
@@ -403,9 +419,24 @@ def main():
         F = fisher.fisher_information(robot, Lc, names, noise, err0=truth)
         crlb = np.sqrt(np.diag(np.linalg.inv(F)))[:6]
         page.monte_carlo(f"Monte Carlo, {label}: RMS/CRLB of dL1..6", np.sqrt(np.mean(E[:, :6] ** 2, axis=0)) / crlb,
-                         lo_r, hi_r, rms_ratio_sd, args.trials, f"{lo_r:.2f}-{hi_r:.2f}")
+                         lo_r, hi_r, rms_ratio_sd, trials, f"{lo_r:.2f}-{hi_r:.2f}")
         page.monte_carlo(f"  mean of e^T F e ({label}; 12 if efficient)", np.mean(np.einsum("ti,ij,tj->t", E, F, E)),
-                         chi, chi, chi2_mean_sd(12), args.trials, f"{chi:.2f}")
+                         chi, chi, chi2_mean_sd(12), trials, f"{chi:.2f}")
+
+
+def main():
+    args = arguments(__doc__, trials=100)
+    robot = load_robot(ROBOT)
+    geo = Geometry(robot)
+    noise_both = robot.noise
+    noise_scale = NoiseModel.named("scale-only", robot)
+    print(f"robot: {ROBOT.name}; noise: scale {noise_both.sigma_scale_mm} mm, legs {noise_both.sigma_joint} mm")
+    draws = np.random.default_rng(2017)  # the random poses
+    legs_and_stroke(robot, draws)
+    forward_kinematics(robot, geo, draws)
+    identifiability(robot, geo, draws)
+    corner_schemes(robot, noise_both, noise_scale)
+    identification(robot, args.trials, args.seed, noise_both, noise_scale)
     return page.exit_code()
 
 

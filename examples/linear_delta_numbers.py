@@ -1,6 +1,6 @@
 """Recompute every number the linear Delta's model page (docs/linear-delta.md) reports as measured, and check it.
 
-Run:  python examples/linear_delta_numbers.py [--trials N]
+Run:  python examples/linear_delta_numbers.py [--trials N] [--seed S]
 
 Each number is printed as ``ok  <what>: <ours> (page: <theirs>)  [tolerance]`` or ``BAD ...``; the exit
 status is 1 if any is BAD.  The page's figures came from an implementation independent of zerocal_sym;
@@ -114,8 +114,8 @@ def main():
                max(np.max(np.abs(np.diff(kin.measuring_vector(robot, P)[0]))) for P in rings.values()), "128")
 
     # ---------------------------------------------------------------- identifiability
-    rng = np.random.default_rng(2017)
-    th40 = kin.ik(robot, random_poses(robot, rng, 40))
+    draws = np.random.default_rng(2017)  # the random poses
+    th40 = kin.ik(robot, random_poses(robot, draws, 40))
     rep = idf.identifiability_report(robot, th40, "all")
     page.exact("all 15 source errors, 40 random poses: rank", rep["rank"], 11)
     page.exact("  its null space is the mechanism's declared gauge (rigid motions)", rep["null_space_rigid"], True)
