@@ -155,12 +155,14 @@ def chi2_mean_sd(dof: int):
     return lambda trials: math.sqrt(2.0 * dof / trials)
 
 
-def monte_carlo_note(trials: int, what: str, chi2: bool = False) -> None:
+def monte_carlo_note(trials: int, what: str, chi2_dof: int | None = None) -> None:
     """Say how the Monte Carlo checks' tolerances come about."""
+    sd = chi2_mean_sd(chi2_dof) if chi2_dof else None
     Page.note(f"Monte Carlo, {what}; {trials} trials per case (the page: {PAGE_TRIALS}).  An RMS/CRLB from N "
               f"trials has a sampling std of 1/sqrt(2N) ({rms_ratio_sd(trials):.3f} here, "
               f"{rms_ratio_sd(PAGE_TRIALS):.3f} for the page's)"
-              + (", a mean of e^T F e (chi-square, p degrees of freedom) sqrt(2p/N)" if chi2 else "")
+              + (f", a mean of e^T F e (chi-square, p = {chi2_dof} degrees of freedom) sqrt(2p/N) ({sd(trials):.3f} "
+                 f"here, {sd(PAGE_TRIALS):.3f} for the page's)" if chi2_dof else "")
               + "; ours and the page's are independent samples, so each check allows 3 standard deviations of "
               "their difference around the page's range")
 

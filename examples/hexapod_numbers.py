@@ -402,7 +402,7 @@ def identification(robot, trials, seed, noise_both, noise_scale):
 
     # ---------------------------------------------------------------- Monte Carlo
     monte_carlo_note(trials, "64 corners, the truth of the noise-free case; weighted Gauss-Newton on the exact "
-                     "model (this script's loop: identify_nlls takes seconds per data set here)", chi2=True)
+                     "model (this script's loop: identify_nlls takes seconds per data set here)", chi2_dof=12)
     for case, (noise, lo_r, hi_r, chi, label) in enumerate(((noise_both, 0.97, 1.04, 12.15, "both noises"),
                                                             (noise_scale, 1.02, 1.05, 12.28, "scale only"))):
         # the linearised estimator at the truth, on the same draws: where a Monte Carlo figure sits off its
