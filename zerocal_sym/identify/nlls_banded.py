@@ -5,7 +5,7 @@ is identified with the CasADi functions of
 :mod:`~zerocal_sym.identify.nlls_problem` (expanded SX, compiled once hot).
 Above, a CasADi graph over K poses costs time and memory in proportion to K
 with a large factor (building its derivatives, the work vectors of the
-unrolled Gauss-Newton block: about 1 GB and 20 s at K = 10^5); :class:`BandedProblem`
+unrolled Gauss-Newton block); :class:`BandedProblem`
 computes the same quantities with the generated kinematics mapped over the
 poses (:func:`zerocal_sym.model.kinematics.distance_jacobians`) and the
 banded algebra of :mod:`~zerocal_sym.identify.banded`:
