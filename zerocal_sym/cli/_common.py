@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import math
 
-#: Poses per boundary when ``--n`` is not given, by scheme: the paper's n = 3
+#: The scheme parameter n when ``--n`` is not given, by scheme: the paper's n = 3
 #: (its eps rule's choice, Section 5); the ring scheme's n = 6 (DELTA.md: n = 4
 #: is the fewest that identify the Delta's 6 parameters, but cond(G) = 3186
-#: there; 233 at n = 6).  A scheme not listed: the fewest that identify.
-DEFAULT_N = {"paper": 3, "ring": 6}
+#: there; 233 at n = 6); the corner scheme's n = 64 (every corner of the box).
+#: A scheme not listed: the fewest that identify.
+DEFAULT_N = {"paper": 3, "ring": 6, "corners": 64}
 
 
 def scheme_names() -> tuple:
@@ -30,8 +31,10 @@ def n_params(robot) -> int:
 
 
 def min_n(robot) -> int:
-    """Fewest poses per boundary whose K - 1 = 2n - 1 changes can identify the p = m + n parameters."""
-    return max(2, math.ceil((n_params(robot) + 1) / 2))
+    """The smallest scheme parameter n whose K - 1 changes (``K = robot.workspace.scheme_size(n)``: 2n on a
+    rectangle or a cylinder, n on a box) can identify the p parameters of the identified set."""
+    ws, p = robot.workspace, n_params(robot)
+    return next(n for n in ws.scheme_sizes(max(8 * p, 128)) if ws.scheme_size(n) - 1 >= p)
 
 
 def default_n(robot) -> int:
@@ -53,7 +56,8 @@ def check_scheme(robot, scheme, option: str = "--scheme") -> str:
 
 
 def scheme_poses(robot, scheme=None, n=None, identifiable: bool = True, option: str = "--scheme"):
-    """The 2n poses of the robot's boundary scheme (the paper's on a rectangle, the ring on a cylinder).
+    """The K poses of the robot's boundary scheme (the paper's on a rectangle, the ring on a cylinder: K = 2n;
+    the corner scheme on a box: K = n).
 
     Parameters
     ----------
@@ -73,9 +77,10 @@ def scheme_poses(robot, scheme=None, n=None, identifiable: bool = True, option: 
     check_scheme(robot, scheme, option)
     n = default_n(robot) if n is None else int(n)
     p = n_params(robot)
-    if identifiable and 2 * n - 1 < p:
-        raise PoseError(f"--n {n} gives K = {2 * n} poses, {2 * n - 1} measured changes: too few to identify the "
-                        f"{p} parameters ({', '.join(robot.errors.resolve('offsets+measuring'))}); "
+    K = robot.workspace.scheme_size(n)
+    if identifiable and K - 1 < p:
+        raise PoseError(f"--n {n} gives K = {K} poses, {K - 1} measured changes: too few to identify the "
+                        f"{p} parameters ({', '.join(robot.errors.resolve('default'))}); "
                         f"n >= {min_n(robot)} needed")
     return robot.workspace.boundary_scheme(n), n
 

@@ -43,7 +43,8 @@ from zerocal_sym.design.constraints import (Constraints, _feasible_random_subset
                                             make_constraints)
 from zerocal_sym.design.criteria import (EXTENDED, _check_criterion, _criterion_weights, _fisher_batch,
                                          _noise_terms, _objective, _objective_batch, _terms_batch, _user_value)
-from zerocal_sym.design.terms import Weights, _crlb_weights, _pose_terms_fn, _qscale, pose_terms
+from zerocal_sym.design.terms import (Weights, _crlb_weights, _pose_terms_fn, _qscale, _user_scale, pose_distances,
+                                      pose_terms)
 
 #: formulation of the matrix inequalities per criterion for p <= 4 (measured best, see module docstring)
 PSD_FORM = {"E": "minors", "cond": "chol"}
@@ -78,7 +79,7 @@ class _NLP:
 
         self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
         self._need_B, self.wts = False, None
-        sm2, sx2 = _noise_terms(noise)
+        sm2, sx2 = _noise_terms(noise, robot)
         qs = _qscale(robot)
         wc = _crlb_weights(robot)
         wts = Weights(robot, tolerances) if criterion in ("position",) + EXTENDED else None
@@ -119,8 +120,8 @@ class _NLP:
             add(s * ca.repmat(ca.DM(np.asarray(cons.mode_signs)), 1, K), cons.singularity_margin + 1e-7, np.inf)
         elif cons.singularity_margin > 0:
             add(s ** 2, (cons.singularity_margin + 1e-7) ** 2, np.inf)
-        if cons.joint_limits_deg is not None:
-            jl = np.radians(np.asarray(cons.joint_limits_deg))
+        if cons.joint_limits is not None:
+            jl = cons.joint_limits_internal()
             for i in range(robot.m):
                 add(theta[i, :], jl[i, 0] + 1e-9, jl[i, 1] - 1e-9)
         aux = []  # (name, symbol column, lb, ub, init(nums) -> values)
@@ -134,8 +135,10 @@ class _NLP:
             add(r[1] - r[0], -np.inf, 1 - 1e-9)
         else:
             add((rho[1:] - rho[:-1]) / l0, -1 + 1e-9, 1 - 1e-9)
-        if cons.min_separation_mm > 0:
-            d2 = [ca.sumsqr(P[:, i] - P[:, j]) / 1e4 for i in range(K) for j in range(i + 1, K)]
+        if cons.min_separation_mm > 0:  # in file units (a degree of an orientation counts as a mm)
+            us = ca.DM(_user_scale(robot))
+            Pu = P * ca.repmat(us, 1, K)
+            d2 = [ca.sumsqr(Pu[:, i] - Pu[:, j]) / 1e4 for i in range(K) for j in range(i + 1, K)]
             add(ca.vertcat(*d2), (cons.min_separation_mm + 1e-6) ** 2 / 1e4, np.inf)
 
         def psd(name, X, X0):
@@ -306,7 +309,7 @@ def _random_start(robot, K, cons, rng, tries=50):
         rho = pose_terms(robot, pts)["rho"]
         close = None
         if cons.min_separation_mm > 0:
-            close = np.linalg.norm(pts[:, None] - pts[None], axis=2) < cons.min_separation_mm
+            close = pose_distances(robot, pts) < cons.min_separation_mm
             np.fill_diagonal(close, False)
         idx = _feasible_random_subset(rng, rho, K, cons, tries=20, close=close)
         if idx is None:
@@ -319,7 +322,7 @@ def _random_start(robot, K, cons, rng, tries=50):
 
 def _scales(robot, P, noise):
     """Normalisations of F_q and G^T G (mean eigenvalue at a reference design)."""
-    sm2, sx2 = _noise_terms(noise)
+    sm2, sx2 = _noise_terms(noise, robot)
     t = pose_terms(robot, P)
     aq = t["a"] * _qscale(robot)
     v = sx2 * np.sum(t["dth"] ** 2, axis=1)
@@ -370,7 +373,7 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
     if not all_starts:
         raise DesignError("could not find a feasible random start: the constraints leave (almost) no room")
     ref = next((P for _, P in all_starts if np.isfinite(_objective_batch(
-        "D", *_terms_batch(robot, P, noise), _noise_terms(noise)[0], _crlb_weights(robot))[0])), all_starts[0][1])
+        "D", *_terms_batch(robot, P, noise), _noise_terms(noise, robot)[0], _crlb_weights(robot))[0])), all_starts[0][1])
     fscale, mscale = _scales(robot, ref, noise)
     nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter, tolerances=tolerances)
     build_s = time.perf_counter() - t0
@@ -380,12 +383,12 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         P, status, iters = nlp.solve(P0)
         viol = check_design(robot, P, cons)
         o = _objective(robot, criterion, P, noise, tolerances)
-        runs.append({"start": label, "value": _user_value(criterion, o), "status": status, "iterations": iters,
+        runs.append({"start": label, "value": _user_value(criterion, o, robot.errors.offset_unit), "status": status, "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
         if not viol and np.isfinite(o) and (best is None or o < best[1]):
             best = (P, o)
     if best is None:
         raise DesignError("no Ipopt start ended at a feasible design; statuses: "
                           + ", ".join(sorted({r["status"] for r in runs})))
-    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1]), "runs": runs,
+    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1], robot.errors.offset_unit), "runs": runs,
             "time_s": time.perf_counter() - t0, "build_s": build_s, "nlp": nlp}
