@@ -207,6 +207,9 @@ class DesignResult:
     approximate: dict | None = None
     tolerances: dict | None = None
     noise_report: dict | None = None
+    #: the baseline's poses in internal units (mm, rad), shape (K, n), or None (``paper["poses"]`` is in file
+    #: units)
+    baseline_poses: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
@@ -406,4 +409,5 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
                         continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme,
                         baseline_note=base_note, baseline_rejected=rejected, baseline_label=base_label,
                         certificate=cert, approximate=approx_info, tolerances=tolerances,
-                        noise_report=dict(noise_dict(robot, noise), description=describe_noise(robot, noise)))
+                        noise_report=dict(noise_dict(robot, noise), description=describe_noise(robot, noise)),
+                        baseline_poses=base)

@@ -68,7 +68,20 @@ def noise_dict(robot, noise) -> dict:
 
 def joint_sigma(robot, noise_d: dict) -> float:
     """The joint term of a :func:`noise_dict` (file units)."""
-    return next(v for k, v in noise_d.items() if k != "sigma_scale_mm")
+    return next(v for k, v in noise_d.items() if k.startswith("sigma_") and k != "sigma_scale_mm")
+
+
+def noise_source(robot, noise) -> str:
+    """Where a noise model comes from: ``paper, Eqs. 34-35``, ``robot file [noise]``, ``mechanism X's default``,
+    or ``""`` (neither: a scaled or partial model)."""
+    from zerocal_sym.model.noise import NoiseModel
+
+    if noise == NoiseModel.paper():
+        return "paper, Eqs. 34-35"
+    if noise == robot.noise:
+        return ("robot file [noise]" if dict(getattr(robot, "noise_values", ()) or {})
+                else f"mechanism {robot.mechanism_name}'s default")
+    return ""
 
 
 def describe_noise(robot, noise) -> str:
@@ -81,11 +94,8 @@ def describe_noise(robot, noise) -> str:
     j = float(offsets_to_user(robot, noise.sigma_joint))
     terms = (f"scale {noise.sigma_scale_mm:g} mm per change + joint {j:g} {offset_unit(robot)} per joint per "
              "pose")
-    if noise == robot.noise:
-        src = ("robot file [noise]" if dict(getattr(robot, "noise_values", ()) or {})
-               else f"mechanism {robot.mechanism_name}'s default")
-        return f"the robot's ({src}): {terms}"
-    return terms
+    src = noise_source(robot, noise)
+    return f"the robot's ({src}): {terms}" if src else terms
 
 
 def pose_units(robot) -> list:
