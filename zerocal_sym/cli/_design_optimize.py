@@ -83,6 +83,9 @@ def resolve_unit_options(args, robot):
         if len(given) > 1:
             raise ZerocalError(f"{given[0][0]} and {given[1][0]} are one option: give it once")
         setattr(args, dest, given[0][1] if given else None)
+        for u in ("deg", "mm"):  # resolved: a second call finds the plain spelling alone
+            if hasattr(args, f"{dest}_{u}"):
+                setattr(args, f"{dest}_{u}", None)
 
 
 def region_arg(values):
@@ -328,6 +331,8 @@ def _print_text(out, res, robot):
         print(f"certificate: no {out['K']}-pose design on the {cert['n_candidates']} candidate poses has {what} "
               f"better than {_fmt(cert['bound'])} {units_.get(what, '')}; this design's efficiency >= "
               f"{_fmt(eff, '.4f')}" + (f" ({cert['note']})" if cert.get("note") else ""))
+        if cert.get("candidates"):
+            print(f"  (candidates: {cert['candidates']})")
     if "verify" in out:
         v = out["verify"]
         print()
@@ -406,7 +411,7 @@ def _run_target(args, robot):
           f"{out['approximate']['n_candidates']} candidate poses can reach it")
     a = out["approximate"]
     print("  support of the design measure (file units, weight): "
-          + "; ".join(f"{tuple(round(x, 2) for x in poses_to_user(robot, np.asarray(s_)))} {w:.3f}"
+          + "; ".join(f"{tuple(round(float(x), 2) for x in poses_to_user(robot, np.asarray(s_)))} {w:.3f}"
                       for s_, w in zip(a["support"], a["support_weights"])))
     print("  evaluated K: " + ", ".join(f"{kk} -> {v:.5g}" for kk, v in out["evaluated"].items()))
     print(f"  ({out['time_s']:.1f} s; the {out['K']} poses: --json)")

@@ -310,6 +310,13 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     cons = cons or make_constraints(robot)
     wts = _criterion_weights(robot, criterion, tolerances) if criterion == "position" else Weights(robot, tolerances)
     X, h = candidate_poses(robot, cons, n_candidates)
+    if np.ndim(h):
+        k = int(round(float((cons.region.hi[0] - cons.region.lo[0]) / h[0]))) + 1
+        grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X)} feasible poses)"
+    else:
+        grid = f"a grid over the region, {h:.3g} mm apart ({len(X)} feasible poses)"
+    candidates = (f"{grid} and {refine} round{'s' if refine != 1 else ''} of local refinement around the "
+                  "measure's support: the bound covers designs on these candidates, not every pose of the region")
     model = PoseModel(robot, X, noise, criterion, wts)
     p = model.aq.shape[1]
     exact, enlarged = _windows(model.rho, cons)
@@ -382,5 +389,5 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
                         loss=loss, bound_loss=bound_loss, window=win, n_candidates=len(model.X), iterations=iters,
                         windows=len(exact), p=p, time_s=time.perf_counter() - t0,
                         info={"grid_mm": h if np.ndim(h) == 0 else np.asarray(h).tolist(), "refine_rounds": refine,
-                              "q": sol["q"]},
+                              "q": sol["q"], "candidates": candidates},
                         unit=robot.errors.offset_unit)

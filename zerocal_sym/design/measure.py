@@ -241,6 +241,8 @@ def solve_measure(model: PoseModel, criterion, w0=None, tol=TOL, max_rounds=60, 
             w /= w.sum()
         for _ in range(max_rounds):
             loss, grad, d, s, M, c = _evaluate(criterion, W, qq, w, aq, vt)
+            if grad is None:
+                raise DesignError("the candidate poses cannot identify the parameters (singular information)")
             eff = s / d.max()
             if eff >= 1 - tol:
                 break

@@ -215,6 +215,13 @@ class DesignResult:
         """JSON-ready report (non-finite numbers as None)."""
         return json_safe(self._dict())
 
+    def _exchange_user(self) -> dict:
+        """The exchange's entry with its poses in file units (as the report's)."""
+        ex = dict(self.exchange)
+        if "poses" in ex:
+            ex["poses"] = _poses_in_units(ex["poses"], self.report.get("pose_units"))
+        return ex
+
     def _dict(self) -> dict:
         rep = dict(self.report)
         pp = self.paper or {}
@@ -240,11 +247,22 @@ class DesignResult:
                 None if self.noise is None else {"sigma_scale_mm": self.noise.sigma_scale_mm,
                                                  "sigma_servo_deg": math.degrees(self.noise.sigma_servo_rad)}),
             "exchange": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                         for k, v in self.exchange.items() if k != "objective"},
+                         for k, v in self._exchange_user().items() if k != "objective"},
             "continuous": {k: v for k, v in self.continuous.items() if k in ("value", "runs", "time_s", "build_s")},
             "timing_s": self.timing,
         })
         return rep
+
+
+def _poses_in_units(P, pose_units):
+    """Poses (internal units) in the file units ``pose_units`` names per coordinate (deg: from rad)."""
+    from zerocal_sym.model import units
+
+    P = np.array(P, float)
+    for i, u in enumerate(pose_units or ()):
+        if u == "deg":
+            P[..., i] = units.to_user(P[..., i], "rad")
+    return P
 
 
 def _ratio(a, b):
@@ -263,7 +281,7 @@ def _certificate(ad, criterion, value, K, design_value_crlb=None):
         return None
     d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K),
          "measure_efficiency_lower_bound": ad.eff_lb, "n_candidates": ad.n_candidates,
-         "rho_window_mm": list(ad.window), "windows": ad.windows,
+         "rho_window_mm": list(ad.window), "windows": ad.windows, "candidates": ad.info.get("candidates"),
          "model": "order-free pose model (servo variance + sigma_m^2/4 per pose): its optimum bounds every "
                   "ordered K-pose design on the candidates"}
     if criterion == ad.criterion:
