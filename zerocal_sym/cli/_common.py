@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import math
 
-#: Poses per boundary when ``--n`` is not given, by scheme: the paper's n = 3
+#: The scheme parameter n when ``--n`` is not given, by scheme: the paper's n = 3
 #: (its eps rule's choice, Section 5); the ring scheme's n = 6 (DELTA.md: n = 4
 #: is the fewest that identify the Delta's 6 parameters, but cond(G) = 3186
-#: there; 233 at n = 6).  A scheme not listed: the fewest that identify.
+#: there; 233 at n = 6); the corner scheme's n = 64 (every corner of the box).
+#: A scheme not listed: the fewest that identify.
 DEFAULT_N = {"paper": 3, "ring": 6, "corners": 64}
 
 
@@ -53,7 +54,8 @@ def check_scheme(robot, scheme, option: str = "--scheme") -> str:
 
 
 def scheme_poses(robot, scheme=None, n=None, identifiable: bool = True, option: str = "--scheme"):
-    """The 2n poses of the robot's boundary scheme (the paper's on a rectangle, the ring on a cylinder).
+    """The K poses of the robot's boundary scheme (the paper's on a rectangle, the ring on a cylinder: K = 2n;
+    the corner scheme on a box: K = n).
 
     Parameters
     ----------

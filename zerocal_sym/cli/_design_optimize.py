@@ -46,9 +46,46 @@ def add_arguments(p):
     p.add_argument("--bias-model", choices=["rms", "worst"], default="rms",
                    help="how --criterion mse counts the bias: rms (expected, errors uniform within the "
                         "tolerances; default) or worst (the worst case within them)")
-    p.add_argument("--target-crlb", type=float, default=None, metavar="DEG",
-                   help="the fewest poses whose design reaches this RMS zero-offset CRLB (deg); the region and "
-                        "constraint options apply")
+    p.add_argument("--target-crlb", type=float, default=None, metavar="X",
+                   help="the fewest poses whose design reaches this RMS zero-offset CRLB, in the joints' unit: deg "
+                        "for revolute, mm for prismatic joints; the region and constraint options apply")
+    p.add_argument("--target-crlb-deg", type=float, default=None, metavar="DEG",
+                   help="--target-crlb spelt with its unit (revolute joints)")
+    p.add_argument("--target-crlb-mm", type=float, default=None, metavar="MM",
+                   help="--target-crlb spelt with its unit (prismatic joints)")
+
+
+#: the options that carry a value in the joints' unit: dest -> the option (each also spelt OPTION-deg, OPTION-mm)
+UNIT_OPTIONS = {"target_crlb": "--target-crlb", "joint_limits": "--joint-limits"}
+
+
+def resolve_unit_options(args, robot):
+    """Each option of :data:`UNIT_OPTIONS` from its plain spelling or the one with the joints' unit.
+
+    ``--joint-limits-deg`` on a robot whose joints are prismatic (or ``--joint-limits-mm`` on revolute ones)
+    is a one-line error naming the right spelling; two spellings of one option, likewise.  The value is left
+    in ``args.<dest>`` (the joints' file unit).
+    """
+    from zerocal_sym.errors import ZerocalError
+    from zerocal_sym.model import units
+
+    ju = units.joint_unit(robot)
+    kind = robot.mechanism.joint_kind
+    for dest, option in UNIT_OPTIONS.items():
+        spelt = {u: getattr(args, f"{dest}_{u}", None) for u in ("deg", "mm")}
+        for u, v in spelt.items():
+            if v is not None and u != ju:
+                raise ZerocalError(f"{option}-{u}: robot {robot.name!r} has {kind} joints "
+                                   f"({', '.join(robot.mechanism.joint_names)}, in {ju}): give {option}-{ju} "
+                                   f"(or {option}) in {ju}")
+        given = [(o, v) for o, v in ((option, getattr(args, dest, None)), (f"{option}-{ju}", spelt[ju]))
+                 if v is not None]
+        if len(given) > 1:
+            raise ZerocalError(f"{given[0][0]} and {given[1][0]} are one option: give it once")
+        setattr(args, dest, given[0][1] if given else None)
+        for u in ("deg", "mm"):  # resolved: a second call finds the plain spelling alone
+            if hasattr(args, f"{dest}_{u}"):
+                setattr(args, f"{dest}_{u}", None)
 
 
 def region_arg(values):
@@ -93,15 +130,17 @@ def constraints_from_args(robot, args):
     """:class:`zerocal_sym.design.Constraints` from the command line."""
     from zerocal_sym import design
 
+    from zerocal_sym.model import units
+
     jl = getattr(args, "joint_limits", None)
     if jl is not None and len(jl) != 2 * robot.m:
         pairs = " ".join(f"LO{j + 1} HI{j + 1}" for j in range(robot.m))
-        raise design.DesignError(f"--joint-limits needs {2 * robot.m} values {pairs} (deg; joints "
-                                 f"{', '.join(robot.mechanism.joint_names)}), got {len(jl)}")
+        raise design.DesignError(f"--joint-limits needs {2 * robot.m} values {pairs} ({units.joint_unit(robot)}; "
+                                 f"joints {', '.join(robot.mechanism.joint_names)}), got {len(jl)}")
     return design.make_constraints(
         robot, region=region_arg(getattr(args, "region", None)), travel_mm=getattr(args, "l0", design.SCALE_RANGE_MM),
         travel_mode=getattr(args, "travel_mode", "range"), singularity_margin=getattr(args, "margin", None),
-        joint_limits_deg=None if jl is None else [(jl[2 * j], jl[2 * j + 1]) for j in range(robot.m)],
+        joint_limits=None if jl is None else [(jl[2 * j], jl[2 * j + 1]) for j in range(robot.m)],
         min_separation_mm=getattr(args, "min_separation", 1.0), bounds=bounds_arg(getattr(args, "bounds", None)))
 
 
@@ -129,13 +168,18 @@ def run(args, robot):
     from zerocal_sym import design
     from zerocal_sym.design import criteria, limits, optimize
     from zerocal_sym.cli._common import check_scheme, default_n, write_out
+    from zerocal_sym.design.terms import okey
     from zerocal_sym.io.files import to_json
     from zerocal_sym.model.noise import NoiseModel
 
     check_scheme(robot, args.scheme)  # the baseline is the robot's own scheme
+    resolve_unit_options(args, robot)
     if getattr(args, "target_crlb", None) is not None:
         return _run_target(args, robot)
-    K = args.K if args.K is not None else 2 * default_n(robot)
+    if getattr(args, "plot", None) and robot.n not in (2, 3):
+        raise design.DesignError(f"--plot draws 2-D and 3-D workspaces; robot {robot.name!r} has {robot.n} pose "
+                                 f"coordinates ({', '.join(robot.mechanism.pose_names)}): use --json")
+    K = args.K if args.K is not None else robot.workspace.scheme_size(default_n(robot))
     limits._check_k(K, robot)
     criteria._check_criterion(args.criterion)
     verify = int(getattr(args, "verify", 0) or 0)
@@ -154,7 +198,7 @@ def run(args, robot):
         raise design.DesignError(f"K = {K} is too large for --method exact (at most {limits.MAX_K_EXACT}; "
                                  "--method approx takes any K)")
     cons = constraints_from_args(robot, args)
-    noise = NoiseModel.named(getattr(args, "noise", "paper"))
+    noise = NoiseModel.named(getattr(args, "noise", "paper"), robot)
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
     try:
         res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
@@ -171,14 +215,14 @@ def run(args, robot):
             vd = design.verify_design(robot, res.poses, verify, noise, seed=args.seed, **ex)
             vp = None
             if res.paper is not None:
-                vp = design.verify_design(robot, np.asarray(res.paper["poses"]), verify, noise, seed=args.seed,
-                                          **ex)
+                vp = design.verify_design(robot, res.baseline_poses, verify, noise, seed=args.seed, **ex)
         finally:
             _parallel.close(ex)
+        rk = okey(robot, "rms_error_rms")
         out["verify"] = {"design": vd, "paper": vp,
-                         "rms_ratio_design_over_paper": None if vp is None else optimize._ratio(
-                             vd["rms_error_rms_deg"], vp["rms_error_rms_deg"]),
-                         "estimator": "zerocal_sym.identify.nlls.identify_nlls (Ipopt, exact model, the zero offsets and the MAEMM)"}
+                         "rms_ratio_design_over_paper": None if vp is None else optimize._ratio(vd[rk], vp[rk]),
+                         "estimator": "zerocal_sym.identify.nlls.identify_nlls (Ipopt, exact model, the zero offsets "
+                                      "and the MAEMM)"}
         if out["paper"] is not None:
             out["paper"]["verify"] = vp
     if args.plot:
@@ -188,27 +232,37 @@ def run(args, robot):
     if args.json:
         print(to_json(out))
         return 0
-    _print_text(out, res)
+    _print_text(out, res, robot)
     return 0
 
 
-def _print_text(out, res):
+def _print_text(out, res, robot):
     import numpy as np
 
+    from zerocal_sym.design.terms import joint_sigma, noise_source, okey, pose_units
+
+    k = lambda stem: okey(robot, stem)  # noqa: E731
+    ju = out.get("joint_unit", "deg")
+    fo = ".4f" if ju == "deg" else ".5f"  # offsets: 4 decimals of a degree, 5 of a mm
     crit = out["criterion"]["name"]
     c = out["constraints"]
-    jl = c["joint_limits_deg"]
+    jl = c[f"joint_limits_{ju}"]
     base = out.get("baseline", "paper")
     pp = out["paper"]
     coords, joints = out["pose_names"], out["joint_names"]
+    pu = out.get("pose_units") or pose_units(robot)
     print(f"Optimised measurement poses: robot {out['robot']}, K = {out['K']}, criterion {crit} "
           f"({_desc(crit)})")
-    print(f"constraints: region {c['region']} mm; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
+    region = c["region"] + (" mm" if set(pu) == {"mm"} or c["region_kind"] != "box" else "")
+    print(f"constraints: region {region}; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "
-          f"{'none' if jl is None else str(jl) + ' deg'}; poses >= {c['min_separation_mm']:g} mm apart")
+          f"{'none' if jl is None else str(jl) + ' ' + ju}; poses >= {c['min_separation_mm']:g} mm apart"
+          + ("" if set(pu) == {"mm"} else " (a degree counts as a mm)"))
     n = out["noise"]
-    print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, servo {n['sigma_servo_deg']:.4g} deg "
-          "per joint per pose")
+    print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, {'servo' if ju == 'deg' else 'joint'} "
+          f"{joint_sigma(robot, n):.4g} {ju} per joint per pose"
+          + (f" ({noise_source(robot, res.noise)})" if res.noise is not None and noise_source(robot, res.noise)
+             else ""))
     ex, co = out["exchange"], out["continuous"]
     if co:
         ok = sum(r["feasible"] for r in co["runs"])
@@ -221,37 +275,37 @@ def _print_text(out, res):
               f"{len(a['support'])} support points, counts {a['counts']}; total {out['timing_s']['total']:.2f} s)")
     P = np.array(out["poses"])
     Pp = np.array(pp["poses"]) if pp is not None else np.full((0, len(coords)), np.nan)
-    J = np.array(out["joints_deg"])
+    J = np.array(out[k("joints")])
     print()
     show = len(P) if len(P) <= 40 else 20
-    print(f"{'k':>3} " + " ".join(f"{x + ' [mm]':>9}" for x in coords) + " "
-          + " ".join(f"{j + ' [deg]':>12}" for j in joints)
+    print(f"{'k':>3} " + " ".join(f"{x + ' [' + u + ']':>9}" for x, u in zip(coords, pu)) + " "
+          + " ".join(f"{j + ' [' + ju + ']':>12}" for j in joints)
           + ("   | " + " ".join(f"{base + ' ' + x:>9}" for x in coords) if pp is not None else ""))
-    for k in range(show):
-        print(f"{k + 1:>3} " + " ".join(f"{v:9.3f}" for v in np.round(P[k], 9) + 0.0) + " "
-              + " ".join(f"{v:12.4f}" for v in J[k])
-              + ("   | " + " ".join(f"{v:9.2f}" for v in np.round(Pp[k], 9) + 0.0) if pp is not None else ""))
+    for i in range(show):
+        print(f"{i + 1:>3} " + " ".join(f"{v:9.3f}" for v in np.round(P[i], 9) + 0.0) + " "
+              + " ".join(f"{v:12.4f}" for v in J[i])
+              + ("   | " + " ".join(f"{v:9.2f}" for v in np.round(Pp[i], 9) + 0.0) if pp is not None else ""))
     if show < len(P):
         print(f"... ({len(P) - show} more poses: --json)")
     print()
     vals = out["criterion"]["values"]
-    pvals = pp["criterion"]["values"] if pp is not None else {k: None for k in vals}
-    units = out["criterion"]["units_all"]
+    pvals = pp["criterion"]["values"] if pp is not None else {c_: None for c_ in vals}
+    units_ = out["criterion"]["units_all"]
     print(f"{'':34}{'design':>12}{(base if pp is not None else ''):>12}{('ratio' if pp is not None else ''):>9}")
     for name in vals:
-        label = f"{name}{' [' + units[name] + ']' if units[name] else ''}{' *' if name == crit else ''}"
+        label = f"{name}{' [' + units_[name] + ']' if units_[name] else ''}{' *' if name == crit else ''}"
         r = vals[name] / pvals[name] if vals[name] is not None and pvals[name] else None
         print(f"  {label:32}{_fmt(vals[name]):>12}{_fmt(pvals[name]):>12}{_fmt(r, '.4g'):>10}")
-    cz = out["crlb_zero_offsets_deg"]
-    pz = pp["crlb_zero_offsets_deg"] if pp is not None else []
-    print(f"  {'CRLB per offset [deg]':32}{' '.join(_fmt(v, '.4f') for v in cz):>12}  "
-          f"{' '.join(_fmt(v, '.4f') for v in pz):>12}")
+    cz = out[k("crlb_zero_offsets")]
+    pz = pp[k("crlb_zero_offsets")] if pp is not None else []
+    print(f"  {'CRLB per offset [' + ju + ']':32}{' '.join(_fmt(v, fo) for v in cz):>12}  "
+          f"{' '.join(_fmt(v, fo) for v in pz):>12}")
     b, pb = out.get("bias"), (pp or {}).get("bias")
     if b:
-        print(f"  {'bias worst case [deg]':32}{' '.join(_fmt(v, '.4f') for v in b['worst_case_deg']):>12}  "
-              f"{' '.join(_fmt(v, '.4f') for v in (pb or {}).get('worst_case_deg', [])):>12}")
-        print(f"  {'bias RMS [deg]':32}{' '.join(_fmt(v, '.4f') for v in b['rms_deg']):>12}  "
-              f"{' '.join(_fmt(v, '.4f') for v in (pb or {}).get('rms_deg', [])):>12}")
+        print(f"  {'bias worst case [' + ju + ']':32}{' '.join(_fmt(v, fo) for v in b[k('worst_case')]):>12}  "
+              f"{' '.join(_fmt(v, fo) for v in (pb or {}).get(k('worst_case'), [])):>12}")
+        print(f"  {'bias RMS [' + ju + ']':32}{' '.join(_fmt(v, fo) for v in b[k('rms')]):>12}  "
+              f"{' '.join(_fmt(v, fo) for v in (pb or {}).get(k('rms'), [])):>12}")
     ps, pps = out.get("position"), (pp or {}).get("position")
     if ps:
         print(f"  {'position error RMS / max [mm]':32}{_fmt(ps['rms_mm']) + ' / ' + _fmt(ps['max_mm']):>12}  "
@@ -262,7 +316,7 @@ def _print_text(out, res):
     print(f"  {'min |sin transmission|':32}{out['min_transmission_sine']:12.4f}"
           f"{_fmt((pp or {}).get('min_transmission_sine'), '.4f'):>12}")
     if b:
-        tol = ", ".join(f"{k} {v:g}" for k, v in b["tolerances"].items())
+        tol = ", ".join(f"{k_} {v:g}" for k_, v in b["tolerances"].items())
         print(f"  (bias: first order from the tolerances {tol} (mm, deg); RMS for uniform errors)")
     print()
     if pp is not None:
@@ -275,28 +329,32 @@ def _print_text(out, res):
         eff = cert.get("efficiency_lower_bound")
         what = cert["criterion"]
         print(f"certificate: no {out['K']}-pose design on the {cert['n_candidates']} candidate poses has {what} "
-              f"better than {_fmt(cert['bound'])} {units.get(what, '')}; this design's efficiency >= "
+              f"better than {_fmt(cert['bound'])} {units_.get(what, '')}; this design's efficiency >= "
               f"{_fmt(eff, '.4f')}" + (f" ({cert['note']})" if cert.get("note") else ""))
+        if cert.get("candidates"):
+            print(f"  (candidates: {cert['candidates']})")
     if "verify" in out:
         v = out["verify"]
         print()
         d, p = v["design"], v["paper"]
         te = d["true_errors"]
-        m = len(te["zero_offsets_deg"])
+        m = len(te[k("zero_offsets")])
         print(f"Monte Carlo: {d['n_trials']} trials each, Ipopt estimator (nlls), true zero offsets "
-              f"{', '.join(f'{x:g}' for x in te['zero_offsets_deg'])} deg, MAEMM {te['maemm_mm']} mm, "
+              f"{', '.join(f'{x:g}' for x in te[k('zero_offsets')])} {ju}, MAEMM {te['maemm_mm']} mm, "
               "no geometric errors")
         w = 9 * m
-        print(f"{'':10}{'RMS error [deg]':>{w}}  {'CRLB at truth [deg]':>{w}}{'RMS':>9}{'CRLB':>9}{'failed':>8}")
+        print(f"{'':10}{'RMS error [' + ju + ']':>{w}}  {'CRLB at truth [' + ju + ']':>{w}}{'RMS':>9}{'CRLB':>9}"
+              f"{'failed':>8}")
         for name, x in (("design", d), (base, p)):
             if x is None:
                 continue
-            print(f"  {name:8}" + "".join(f"{e:9.4f}" for e in x["rms_error_deg"]) + "  "
-                  + "".join(f"{e:9.4f}" for e in x["crlb_at_truth_deg"])
-                  + f"{x['rms_error_rms_deg']:9.4f}{x['crlb_at_truth_rms_deg']:9.4f}{x['n_failed']:8d}")
+            print(f"  {name:8}" + "".join(format(e, "9" + fo) for e in x[k("rms_error")]) + "  "
+                  + "".join(format(e, "9" + fo) for e in x[k("crlb_at_truth")])
+                  + format(x[k('rms_error_rms')], "9" + fo) + format(x[k('crlb_at_truth_rms')], "9" + fo)
+                  + f"{x['n_failed']:8d}")
         if p is not None:
             print(f"  ratio design / {base}: RMS error {_fmt(v['rms_ratio_design_over_paper'], '.4f')}, CRLB "
-                  f"{_fmt(d['crlb_at_truth_rms_deg'] / p['crlb_at_truth_rms_deg'], '.4f')}")
+                  f"{_fmt(d[k('crlb_at_truth_rms')] / p[k('crlb_at_truth_rms')], '.4f')}")
     if "plot" in out:
         print(f"plot: {out['plot']}")
 
@@ -308,44 +366,54 @@ def _run_target(args, robot):
     from zerocal_sym import design
     from zerocal_sym.cli._common import write_out
     from zerocal_sym.design.fewest import fewest_poses
+    from zerocal_sym.design.terms import describe_noise, noise_dict, okey, pose_units, poses_to_user
     from zerocal_sym.io.files import json_safe, to_json
     from zerocal_sym.model import kinematics as kin
+    from zerocal_sym.model import units
     from zerocal_sym.model.noise import NoiseModel
 
     if getattr(args, "plot", None):
         raise design.DesignError("--plot is for --optimize (a --target-crlb design has K in the hundreds)")
+    k = lambda stem: okey(robot, stem)  # noqa: E731
+    ju = units.joint_unit(robot)
     cons = constraints_from_args(robot, args)
-    noise = NoiseModel.named(getattr(args, "noise", "paper"))
+    noise = NoiseModel.named(getattr(args, "noise", "paper"), robot)
     res = fewest_poses(robot, args.target_crlb, cons, noise)
     P = np.asarray(res["poses"])
-    out = {"robot": robot.name, "mechanism": robot.mechanism_name, "target_crlb_deg": res["target_crlb_deg"],
-           "K": res["K"], "K_lower_bound": res["K_lower_bound"], "crlb_rms_deg": res["crlb_rms_deg"],
-           "crlb_zero_offsets_deg": None, "poses": P.tolist(), "pose_names": list(robot.mechanism.pose_names),
-           "joints_deg": np.degrees(kin.ik(robot, P)).tolist(), "joint_names": list(robot.mechanism.joint_names),
+    theta = kin.ik(robot, P)
+    out = {"robot": robot.name, "mechanism": robot.mechanism_name, "unit": ju,
+           k("target_crlb"): res[k("target_crlb")],
+           "K": res["K"], "K_lower_bound": res["K_lower_bound"], k("crlb_rms"): res[k("crlb_rms")],
+           k("crlb_zero_offsets"): None, "poses": poses_to_user(robot, P).tolist(), "pose_units": pose_units(robot),
+           "pose_names": list(robot.mechanism.pose_names),
+           k("joints"): units.joints_to_user(robot, theta).tolist(), "joint_names": list(robot.mechanism.joint_names),
            "evaluated": res["evaluated"], "approximate": res["approximate"],
            "constraints": cons.to_dict(), "violations": design.check_design(robot, P, cons),
-           "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_deg": float(np.degrees(noise.sigma_servo_rad))},
+           "noise": dict(noise_dict(robot, noise), description=describe_noise(robot, noise)),
            "bound": "no design of fewer than K_lower_bound poses on the candidate poses reaches the target "
                     "(certificate of the optimal design measure); K is the fewest poses of the rounded designs",
            "time_s": res["time_s"]}
     from zerocal_sym.identify import fisher
 
-    out["crlb_zero_offsets_deg"] = fisher.crlb_zero_offsets_deg(robot, kin.ik(robot, P), "paper", noise).tolist()
+    out[k("crlb_zero_offsets")] = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise).tolist()
     out = json_safe(out)
     write_out(args, out)
     if args.json:
         print(to_json(out))
         return 0
-    print(f"Fewest poses for an RMS zero-offset CRLB of {out['target_crlb_deg']:g} deg: robot {out['robot']}, "
-          f"region {cons.region.describe()} mm")
-    print(f"  K = {out['K']} (design CRLB {out['crlb_rms_deg']:.5g} deg; per offset "
-          f"{', '.join(f'{v:.5g}' for v in out['crlb_zero_offsets_deg'])})")
+    from zerocal_sym.design.constraints import region_text
+
+    print(f"Fewest poses for an RMS zero-offset CRLB of {out[k('target_crlb')]:g} {ju}: robot {out['robot']}, "
+          f"region {region_text(cons.region)}")
+    print(f"  K = {out['K']} (design CRLB {out[k('crlb_rms')]:.5g} {ju}; per offset "
+          f"{', '.join(f'{v:.5g}' for v in out[k('crlb_zero_offsets')])})")
     print(f"  certified: no design of fewer than {out['K_lower_bound']} poses on the "
           f"{out['approximate']['n_candidates']} candidate poses can reach it")
     a = out["approximate"]
-    print(f"  support of the design measure (mm, weight): "
-          + "; ".join(f"{tuple(round(x, 2) for x in s)} {w:.3f}" for s, w in zip(a["support"], a["support_weights"])))
-    print(f"  evaluated K: " + ", ".join(f"{k} -> {v:.5g}" for k, v in out["evaluated"].items()))
+    print("  support of the design measure (file units, weight): "
+          + "; ".join(f"{tuple(round(float(x), 2) for x in poses_to_user(robot, np.asarray(s_)))} {w:.3f}"
+                      for s_, w in zip(a["support"], a["support_weights"])))
+    print("  evaluated K: " + ", ".join(f"{kk} -> {v:.5g}" for kk, v in out["evaluated"].items()))
     print(f"  ({out['time_s']:.1f} s; the {out['K']} poses: --json)")
     return 0
 

@@ -17,7 +17,9 @@ def run(args, robot):
 
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.errors import PoseError, ZerocalError
-    from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
+    from zerocal_sym.design.terms import describe_noise, noise_dict, okey
+    from zerocal_sym.identify.fisher import crlb_zero_offsets_user
+    from zerocal_sym.model import units
     from zerocal_sym.io.files import to_json
     from zerocal_sym.model.noise import NoiseModel
     from zerocal_sym.paper.reproduction import kappas, select_n
@@ -48,8 +50,10 @@ def run(args, robot):
     k1, km = kappas(robot, n, prior)
     eps = (k1 - km) / k1
     s = np.linalg.svd(identification_matrix(robot, P, prior)[0], compute_uv=False)
-    crlb = crlb_zero_offsets_deg(robot, theta, "paper", NoiseModel.paper())
-    crlb_scale = crlb_zero_offsets_deg(robot, theta, "paper", NoiseModel.named("scale-only"))
+    noise = robot.noise
+    crlb = crlb_zero_offsets_user(robot, theta, "default", noise)
+    crlb_scale = crlb_zero_offsets_user(robot, theta, "default", NoiseModel.named("scale-only", robot))
+    k = lambda stem: okey(robot, stem)  # noqa: E731
     readings = {label: kappas(robot, n, pr)[1] for label, pr in MAEMM_PRIOR_READINGS.items()}
     out = {
         "scheme": "paper",
@@ -57,7 +61,7 @@ def run(args, robot):
         "n": n,
         "K": 2 * n,
         "poses": P.tolist(),
-        "joints_deg": np.degrees(theta).tolist(),
+        k("joints"): units.joints_to_user(robot, theta).tolist(),
         "kappa_1": k1,
         "kappa_m": km,
         "eps": eps,
@@ -70,9 +74,10 @@ def run(args, robot):
         "kappa_m_readings": {label: {"maemm_prior_mm": list(pr), "kappa_m": readings[label]}
                              for label, pr in MAEMM_PRIOR_READINGS.items()},
         "singular_values_with_prior": s.tolist(),
-        "crlb_zero_offsets_deg": crlb.tolist(),
-        "crlb_noise": "paper (Eq. 34 scale + Eq. 35 servo)",
-        "crlb_zero_offsets_deg_scale_only": crlb_scale.tolist(),
+        k("crlb_zero_offsets"): crlb.tolist(),
+        "crlb_noise": describe_noise(robot, noise),
+        "noise": noise_dict(robot, noise),
+        k("crlb_zero_offsets") + "_scale_only": crlb_scale.tolist(),
     }
     if robot.name == "paper":
         out["paper"] = {"n": 3, "kappa_1": PAPER_KAPPA_1, "kappa_m": PAPER_KAPPA_M}
@@ -89,6 +94,7 @@ def run(args, robot):
     print("kappa_m for the readings of the paper's prior (1, 0.5) mm:")
     for label, pr in MAEMM_PRIOR_READINGS.items():
         print(f"  {label:40s} prior {pr} mm in our frame: kappa_m = {readings[label]:.3f}")
-    print(f"CRLB of the zero offsets: {crlb[0]:.4f} / {crlb[1]:.4f} deg (paper noise: scale + servo), "
-          f"{crlb_scale[0]:.4f} / {crlb_scale[1]:.4f} deg (scale error alone)")
+    ju = units.joint_unit(robot)
+    print("CRLB of the zero offsets: " + " / ".join(f"{v:.4f}" for v in crlb) + f" {ju} (noise: "
+          f"{out['crlb_noise']}), " + " / ".join(f"{v:.4f}" for v in crlb_scale) + f" {ju} (scale error alone)")
     return 0

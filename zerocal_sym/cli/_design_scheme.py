@@ -1,28 +1,34 @@
-"""``zerocal design --scheme ring`` (and any boundary scheme but the paper's): the scheme's poses and numbers.
+"""``zerocal design --scheme ring|corners`` (any boundary scheme but the paper's): the scheme's poses and numbers.
 
-Prints the 2n poses of the robot's boundary scheme
-(``robot.workspace.boundary_scheme(n)``; the ring scheme of DELTA.md on a
-cylindrical workspace) with their joint angles, ``kappa_1`` -- the condition
-number of the paper's identification matrix G (Eq. 28 for m joints and n
-pose coordinates, :func:`zerocal_sym.identify.linear.identification_matrix`,
-no MAEMM prior) -- and the Cramér-Rao bound of each zero offset under the
-paper's noise model (and under the scale error alone).  ``kappa_m`` and the
-eps rule are the paper's (``--scheme paper``); here, without ``--n``, n is
-the scheme's default and the table of ``kappa_1`` and the CRLB over n is
-printed beside it.  With ``--maemm-prior`` (n values, mm) also the condition
+Prints the K poses of the robot's boundary scheme
+(``robot.workspace.boundary_scheme(n)``, ``K = robot.workspace.scheme_size(n)``:
+the ring scheme on a cylindrical workspace, ``K = 2n``; the corner scheme on a
+box, ``K = n`` corners) with their joints, ``kappa_1`` -- the condition number
+of the paper's identification matrix G over the mechanism's identified set
+(Eq. 28 for m joints and n pose coordinates,
+:func:`zerocal_sym.identify.linear.identification_matrix`, no MAEMM prior) --
+and the Cramér-Rao bound of each zero offset under the robot's noise model
+(:attr:`Robot.noise`: its file's ``[noise]``, its mechanism's default, else the
+paper's) and under the scale error alone.  Joint values and offsets are in the
+joints' file unit, and so are the keys that carry them (``joints_deg``,
+``crlb_zero_offsets_deg`` for revolute joints; ``joints_mm``,
+``crlb_zero_offsets_mm`` for prismatic ones).  ``kappa_m`` and the eps rule are
+the paper's (``--scheme paper``); here, without ``--n``, n is the scheme's
+default and the table of ``kappa_1`` and the CRLB over n is printed beside it.
+With ``--maemm-prior`` (one value per measuring error, mm) also the condition
 number of G with the prior (Eq. 30).
 """
 from __future__ import annotations
 
-#: the largest n of the table printed without --n
+#: the largest n of the table printed without --n (a scheme whose n are fewer, the corner scheme's: all of them)
 N_TABLE_MAX = 12
 
 
-def _numbers(robot, n, noise_paper, noise_scale):
+def _numbers(robot, n, noise, noise_scale):
     import numpy as np
 
     from zerocal_sym.errors import ZerocalError
-    from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
+    from zerocal_sym.identify.fisher import crlb_zero_offsets_user
     from zerocal_sym.identify.linear import condition_number, identification_matrix
     from zerocal_sym.model import kinematics as kin
 
@@ -30,20 +36,31 @@ def _numbers(robot, n, noise_paper, noise_scale):
     theta = kin.check_poses(robot, P, in_workspace=True)
     G, lam = identification_matrix(robot, P, theta=theta)
     try:
-        crlb = crlb_zero_offsets_deg(robot, theta, "paper", noise_paper)
-        crlb_s = crlb_zero_offsets_deg(robot, theta, "paper", noise_scale)
+        crlb = crlb_zero_offsets_user(robot, theta, "default", noise)
+        crlb_s = crlb_zero_offsets_user(robot, theta, "default", noise_scale)
     except ZerocalError:
         crlb = crlb_s = np.full(robot.m, np.inf)
     return P, theta, G, lam, condition_number(G), crlb, crlb_s
+
+
+def table_parameters(robot, n, nmin):
+    """The scheme parameters of the n table: from ``nmin`` up to :data:`N_TABLE_MAX` (and ``n``), those the
+    scheme has (every n of the ring; 16, 32, 64 of the corner scheme)."""
+    ws = robot.workspace
+    top = ws.scheme_size(max(N_TABLE_MAX, n))
+    return [k for k in ws.scheme_sizes(top) if k >= nmin]
 
 
 def run(args, robot):
     import numpy as np
 
     from zerocal_sym.cli._common import default_n, min_n, n_params, vector_arg, write_out
+    from zerocal_sym.design.terms import describe_noise, noise_dict, okey, pose_units
     from zerocal_sym.errors import PoseError, ZerocalError
     from zerocal_sym.identify.linear import condition_number, identification_matrix
     from zerocal_sym.io.files import json_safe, to_json
+    from zerocal_sym.model import units
+    from zerocal_sym.model.kinematics import fmt_user_pose
     from zerocal_sym.model.noise import NoiseModel
 
     ws = robot.workspace
@@ -55,34 +72,46 @@ def run(args, robot):
                            "give --n")
     p = n_params(robot)
     nmin = min_n(robot)
-    if args.n is not None and args.n < nmin:
-        raise PoseError(f"--n {args.n} gives K = {2 * args.n} poses, {2 * args.n - 1} measured changes: too few for "
-                        f"the {p} parameters ({', '.join(errors.resolve('offsets+measuring'))}); n >= {nmin} needed")
+    params = list(errors.resolve("default"))
+    if args.n is not None:
+        K = ws.scheme_size(args.n)
+        if K - 1 < p:
+            raise PoseError(f"--n {args.n} gives K = {K} poses, {K - 1} measured changes: too few for the {p} "
+                            f"parameters ({', '.join(params)}); n >= {nmin} needed")
     n = args.n if args.n is not None else default_n(robot)
-    noise, noise_s = NoiseModel.paper(), NoiseModel.named("scale-only")
+    K = ws.scheme_size(n)
+    noise, noise_s = robot.noise, NoiseModel.named("scale-only", robot)
     P, theta, G, lam, k1, crlb, crlb_s = _numbers(robot, n, noise, noise_s)
     s = np.linalg.svd(G, compute_uv=False)
+    ju = units.joint_unit(robot)
+    revolute = mech.joint_kind == "revolute"
+    per = "poses per boundary" if K == 2 * n else "corners" if scheme == "corners" else "poses"
     out = {
         "scheme": scheme,
         "robot": robot.name,
         "mechanism": robot.mechanism_name,
         "workspace": ws.describe(),
         "n": n,
-        "K": 2 * n,
+        "K": K,
         "selected_by": "--n" if args.n is not None else f"default of the {scheme} scheme",
         "pose_names": list(mech.pose_names),
+        "pose_units": pose_units(robot),
         "joint_names": list(mech.joint_names),
-        "poses": P.tolist(),
-        "joints_deg": np.degrees(theta).tolist(),
-        "params": list(errors.resolve("default")),
+        "joint_unit": ju,
+        "poses": units.pose_to_user(robot, P).tolist(),
+        okey(robot, "joints"): units.joints_to_user(robot, theta).tolist(),
+        "params": params,
         "kappa_1": k1,
-        "kappa_1_note": "condition number of the paper's G (Eq. 28; offsets as L_i dtheta_i and MAEMM in mm), "
-                        "no MAEMM prior",
+        "kappa_1_note": ("condition number of the paper's G (Eq. 28; offsets as L_i dtheta_i and MAEMM in mm), "
+                         "no MAEMM prior") if revolute else
+                        ("condition number of the paper's G (Eq. 28; offsets and measuring errors in mm), "
+                         "no MAEMM prior"),
         "singular_values": s.tolist(),
         "rho_span_mm": float(np.ptp(lam)),
-        "crlb_zero_offsets_deg": crlb.tolist(),
-        "crlb_noise": "paper (Eq. 34 scale + Eq. 35 servo)",
-        "crlb_zero_offsets_deg_scale_only": crlb_s.tolist(),
+        okey(robot, "crlb_zero_offsets"): crlb.tolist(),
+        "crlb_noise": describe_noise(robot, noise),
+        "noise": noise_dict(robot, noise),
+        okey(robot, "crlb_zero_offsets") + "_scale_only": crlb_s.tolist(),
     }
     if args.maemm_prior is not None:
         prior = vector_arg(args.maemm_prior, len(errors.measuring), "--maemm-prior", errors.measuring, "mm")
@@ -90,14 +119,15 @@ def run(args, robot):
         out["kappa_with_prior"] = condition_number(identification_matrix(robot, P, prior, theta=theta)[0])
     if args.n is None:
         table = []
-        for k in range(nmin, max(N_TABLE_MAX, n) + 1):
+        for k in table_parameters(robot, n, nmin):
+            kk_ = ws.scheme_size(k)
             try:
                 *_, kk, c, cs = _numbers(robot, k, noise, noise_s)
             except PoseError as exc:
-                table.append({"n": k, "K": 2 * k, "error": str(exc)})
+                table.append({"n": k, "K": kk_, "error": str(exc)})
                 continue
-            table.append({"n": k, "K": 2 * k, "kappa_1": kk, "crlb_rms_deg": float(np.sqrt(np.mean(c**2))),
-                          "crlb_rms_deg_scale_only": float(np.sqrt(np.mean(cs**2)))})
+            table.append({"n": k, "K": kk_, "kappa_1": kk, okey(robot, "crlb_rms"): float(np.sqrt(np.mean(c**2))),
+                          okey(robot, "crlb_rms") + "_scale_only": float(np.sqrt(np.mean(cs**2)))})
         out["n_table"] = table
     out = json_safe(out)
     write_out(args, out)
@@ -105,26 +135,29 @@ def run(args, robot):
         print(to_json(out))
         return 0
     joints = ", ".join(mech.joint_names)
-    coords = ", ".join(mech.pose_names)
-    print(f"{scheme} scheme on robot {robot.name} ({robot.mechanism_name}; workspace {ws.describe()} mm): "
-          f"n = {n} poses per boundary, K = {2 * n} ({out['selected_by']})")
-    for k, (pk, tk) in enumerate(zip(P, np.degrees(theta)), 1):
-        pos = ", ".join(f"{v:8.3f}" for v in np.round(pk, 9) + 0.0)
-        ang = ", ".join(f"{v:9.4f}" for v in tk)
-        print(f"  P{k:<2d} ({coords}) = ({pos}) mm   ({joints}) = ({ang}) deg")
+    print(f"{scheme} scheme on robot {robot.name} ({robot.mechanism_name}; workspace {ws.describe()}"
+          f"{' mm' if set(pose_units(robot)) == {'mm'} else ''}): n = {n} {per}, K = {K} ({out['selected_by']})")
+    show = K if K <= 40 else 16
+    for k in range(show):
+        ang = ", ".join(f"{v:9.4f}" for v in units.joints_to_user(robot, theta[k]))
+        print(f"  P{k + 1:<2d} {fmt_user_pose(robot, np.round(P[k], 12) + 0.0, '8.3f')}   ({joints}) = ({ang}) {ju}")
+    if show < K:
+        print(f"  ... ({K - show} more poses: --json)")
     print(f"kappa_1 = {k1:.3f} (G of the {p} parameters {', '.join(out['params'])}, no MAEMM prior)"
           + (f"; with the MAEMM prior {out['maemm_prior_mm']} mm: {out['kappa_with_prior']:.3f}"
              if "kappa_with_prior" in out else ""))
-    print("CRLB of the zero offsets: " + " / ".join(f"{v:.4f}" for v in crlb) + " deg (paper noise: scale + servo), "
-          + " / ".join(f"{v:.4f}" for v in crlb_s) + " deg (scale error alone)")
+    fmt = ".4f" if revolute else ".5f"
+    print("CRLB of the zero offsets: " + " / ".join(format(v, fmt) for v in crlb) + f" {ju} (noise: "
+          f"{out['crlb_noise']}), " + " / ".join(format(v, fmt) for v in crlb_s) + f" {ju} (scale error alone)")
     if "n_table" in out:
-        print(f"other n (n >= {nmin}: K - 1 >= {p} changes):")
-        print(f"  {'n':>3} {'K':>3} {'kappa_1':>10} {'CRLB rms [deg]':>15} {'scale only':>11}")
+        kr = okey(robot, "crlb_rms")
+        print(f"other n (K - 1 >= {p} changes):")
+        print(f"  {'n':>3} {'K':>3} {'kappa_1':>10} {'CRLB rms [' + ju + ']':>15} {'scale only':>11}")
         for row in out["n_table"]:
             if "error" in row:
                 print(f"  {row['n']:3d} {row['K']:3d}  {row['error']}")
                 continue
             mark = "  <- default" if row["n"] == n else ""
-            print(f"  {row['n']:3d} {row['K']:3d} {row['kappa_1']:10.1f} {row['crlb_rms_deg']:15.4f} "
-                  f"{row['crlb_rms_deg_scale_only']:11.4f}{mark}")
+            print(f"  {row['n']:3d} {row['K']:3d} {row['kappa_1']:10.1f} {format(row[kr], '15' + fmt)} "
+                  f"{format(row[kr + '_scale_only'], '11' + fmt)}{mark}")
     return 0

@@ -1,51 +1,64 @@
 """Measurement-pose design.
 
 ``--scheme`` (default: the robot's own) -- the boundary scheme of the robot's
-workspace, n poses on each of its two boundaries, K = 2n:
+workspace (``K = robot.workspace.scheme_size(n)``):
 
 * ``paper`` (a rectangular workspace, the paper's Section 5): n evenly
-  spaced poses on y = H and on y = H + h (each from x = -b/2 to +b/2);
-  prints kappa_1, kappa_m (with the MAEMM prior, Eq. 30), the eps rule
-  (Eq. 31; without ``--n`` the smallest n with eps <= eps0) and the CRLB of
-  the zero offsets;
-* ``ring`` (a cylindrical workspace, the rotary Delta of DELTA.md): n poses
-  on the top circle at azimuths 360 deg j/n, then on the bottom one; prints
-  kappa_1 (the condition number of the paper's G, Eq. 28 in 3-D, no MAEMM
-  prior), the CRLB of the zero offsets (paper noise and scale error alone)
-  and, without ``--n``, the default n = 6 with kappa_1 and the CRLB for the
-  other n.
+  spaced poses on y = H and on y = H + h (each from x = -b/2 to +b/2),
+  K = 2n; prints kappa_1, kappa_m (with the MAEMM prior, Eq. 30), the eps
+  rule (Eq. 31; without ``--n`` the smallest n with eps <= eps0) and the
+  CRLB of the zero offsets;
+* ``ring`` (a cylindrical workspace, the Deltas): n poses on the top circle
+  at azimuths 360 deg j/n (from the workspace's ring azimuth), then on the
+  bottom one, K = 2n; prints kappa_1 (the condition number of the paper's G
+  over the mechanism's identified set, no MAEMM prior), the CRLB of the zero
+  offsets (the robot's noise and the scale error alone) and, without
+  ``--n``, the default n = 6 with kappa_1 and the CRLB for the other n;
+* ``corners`` (a box workspace, the hexapod's 6-D pose): K = n corners of the
+  box, all 64 (default) or the regular fraction of 32 or 16; the same numbers.
+
+Joint values, the CRLB of the zero offsets and the options that carry them
+are in the joints' unit: deg for revolute joints, mm for prismatic ones (JSON
+keys ``joints_deg``, ``crlb_zero_offsets_deg`` or ``joints_mm``,
+``crlb_zero_offsets_mm``); the noise is the robot's (its file's ``[noise]``,
+its mechanism's default, else the paper's).
 
 A scheme that does not fit the robot's workspace is an error naming the
 right one.
 
 ``--optimize``: K poses chosen by a constrained optimisation (CasADi/Ipopt
-and a discrete exchange) for a criterion, over the robot's workspace shape
-(a rectangle or a cylinder), compared with the boundary scheme at the same K.
+and a discrete exchange, or the approximate design with its certificate) for
+a criterion, over the robot's workspace shape (a rectangle, a cylinder, a
+box), compared with the boundary scheme at the same K.
 """
 NAME = "design"
-HELP = "measurement poses: the robot's boundary scheme (paper, ring) or an optimised design"
+HELP = "measurement poses: the robot's boundary scheme (paper, ring, corners) or an optimised design"
 
 
 def add_arguments(p):
     from zerocal_sym.cli._paths import OutputFile
 
     p.add_argument("--scheme", choices=["paper", "ring", "corners"], default=None,
-                   help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
+                   help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder, corners on a "
+                        "box)")
     p.add_argument("--n", type=int, default=None,
-                   help="poses per boundary; default: the eps0 rule (paper), 6 (ring)")
+                   help="poses per boundary (paper, ring: K = 2n) or corners (corners: K = n = 64, 32 or 16); "
+                        "default: the eps0 rule (paper), 6 (ring), 64 (corners)")
     p.add_argument("--eps0", type=float, default=None, help="threshold of the paper's eps rule (default 0.01)")
     p.add_argument("--maemm-prior", nargs="+", type=float, metavar="MM", default=None,
-                   help="MAEMM prior (mm, one value per pose coordinate) for kappa_m (paper; default: see "
-                        "docs/reproduction.md) or kappa with the prior (ring)")
+                   help="MAEMM prior (mm, one value per measuring error) for kappa_m (paper; default: see "
+                        "docs/reproduction.md) or kappa with the prior (ring, corners)")
     p.add_argument("--optimize", action="store_true", help="optimise the poses instead of the boundary scheme")
     p.add_argument("--K", type=int, default=None,
-                   help="number of poses (--optimize; default 2n of the scheme's default: 6 paper, 12 ring)")
+                   help="number of poses (--optimize; default the K of the scheme's default n: 6 paper, 12 ring, "
+                        "64 corners)")
     p.add_argument("--criterion", choices=["cond", "D", "A", "E", "crlb", "position", "mse"], default="crlb",
                    help="design criterion (--optimize)")
     p.add_argument("--region", nargs="+", metavar="SPEC", default=None,
                    help="design region (default: the workspace): XMIN XMAX YMIN YMAX on a rectangle, RW ZMIN ZMAX "
-                        "on a cylinder (mm, reachable everywhere); 'reachable' (the reachable non-singular set, "
-                        "clipped by --bounds); 'polygon X1 Y1 X2 Y2 ...' (planar)")
+                        "on a cylinder (mm), X_MIN X_MAX ... YAW_MIN YAW_MAX on a box (mm, deg for orientations); "
+                        "reachable everywhere; 'reachable' (the reachable non-singular set, clipped by --bounds; "
+                        "poses of positions only); 'polygon X1 Y1 X2 Y2 ...' (planar)")
     p.add_argument("--seed", type=int, default=0, help="seed of the multi-start")
     p.add_argument("--verify", type=int, default=0, metavar="N", help="Monte Carlo trials to verify the CRLB")
     from zerocal_sym.cli import _parallel
@@ -61,12 +74,21 @@ def add_arguments(p):
                    help="l0 bounds the span of rho over all poses (range, default) or each change (consecutive)")
     p.add_argument("--margin", type=float, default=None,
                    help="min |sin| of every transmission angle (--optimize; default: the robot's)")
-    p.add_argument("--joint-limits", nargs="+", type=float, metavar="DEG", default=None,
-                   help="joint limits in deg, LO HI per joint: LO1 HI1 LO2 HI2 [LO3 HI3] (--optimize; default none)")
+    p.add_argument("--joint-limits", nargs="+", type=float, metavar="LIM", default=None,
+                   help="joint limits in the joints' unit: deg for revolute, mm for prismatic joints; LO HI per "
+                        "joint: LO1 HI1 LO2 HI2 ... (--optimize; default none)")
+    p.add_argument("--joint-limits-deg", nargs="+", type=float, metavar="DEG", default=None,
+                   help="--joint-limits spelt with its unit (revolute joints)")
+    p.add_argument("--joint-limits-mm", nargs="+", type=float, metavar="MM", default=None,
+                   help="--joint-limits spelt with its unit (prismatic joints)")
     p.add_argument("--min-separation", type=float, default=1.0, metavar="MM",
-                   help="min distance between two poses in mm (--optimize; default 1)")
-    p.add_argument("--noise", choices=["paper", "scale-only", "servo-only"], default="paper",
-                   help="noise model of the Fisher-information criteria (--optimize; default paper)")
+                   help="min distance between two poses in mm; for a pose with orientations a degree counts as a "
+                        "mm (--optimize; default 1)")
+    p.add_argument("--noise", choices=["default", "paper", "scale-only", "servo-only", "joint-only"],
+                   default="default",
+                   help="noise model of the Fisher-information criteria (--optimize): the robot's (default: its "
+                        "file's [noise], its mechanism's, else the paper's Eqs. 34-35; 'paper' is the same), its "
+                        "scale term alone, its joint term alone (servo-only = joint-only)")
     p.add_argument("--starts", type=int, default=8, help="random Ipopt starts and exchange starts (--optimize)")
     from zerocal_sym.cli import _design_optimize
 
@@ -77,7 +99,10 @@ def run(args):
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.cli._common import check_scheme
 
+    from zerocal_sym.cli._design_optimize import resolve_unit_options
+
     robot = load_robot_arg(args)
+    resolve_unit_options(args, robot)
     if args.optimize or getattr(args, "target_crlb", None) is not None:
         from zerocal_sym.cli import _design_optimize
 

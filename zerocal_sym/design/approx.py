@@ -88,8 +88,20 @@ def _box_grid(reg, n_target):
     return X, h
 
 
-def _local_grid(x, h, n, steps=3):
-    """Points ``x + h * (i, j[, k])`` for integer offsets in ``[-steps, steps]``, shape (M, n)."""
+#: points of a local refinement grid around a support point, at most (:func:`_local_grid`)
+LOCAL_GRID_MAX = 1000
+
+
+def _local_grid(x, h, n, steps=None):
+    """Points ``x + h * (i, j[, k])`` for integer offsets in ``[-steps, steps]``, shape (M, n).
+
+    ``h``: the spacing, a number or one per coordinate.  ``steps`` default: 3, fewer where ``(2 steps + 1)^n``
+    would pass :data:`LOCAL_GRID_MAX` (in 6-D: 1, the 729 neighbours of the point).
+    """
+    if steps is None:
+        steps = 3
+        while steps > 1 and (2 * steps + 1) ** n > LOCAL_GRID_MAX:
+            steps -= 1
     r = np.arange(-steps, steps + 1)
     off = np.stack(np.meshgrid(*([r] * n), indexing="ij"), axis=-1).reshape(-1, n) * h
     return x + off
@@ -151,6 +163,8 @@ class ApproxDesign:
     p: int
     time_s: float
     info: dict = field(default_factory=dict)
+    #: the zero offsets' internal unit (rad, mm): the crlb criterion's value is in its file unit (deg, mm)
+    unit: str = "rad"
 
     def sensitivity(self, robot, noise=None):
         """``d(x) / s`` of the measure at new poses: a function of ``X`` (M, n) -> (M,) (1 on the support)."""
@@ -171,11 +185,11 @@ class ApproxDesign:
 
     def value(self, K):
         """The measure's criterion for K poses in user units (the order-free pose model)."""
-        return _mass_value(self.criterion, self.loss, K, self.p)
+        return _mass_value(self.criterion, self.loss, K, self.p, self.unit)
 
     def bound(self, K):
         """Best value any ordered K-pose design on the candidates can reach (user units)."""
-        return _mass_value(self.criterion, self.bound_loss, K, self.p)
+        return _mass_value(self.criterion, self.bound_loss, K, self.p, self.unit)
 
     def efficiency(self, value, K):
         """Lower bound on the efficiency of a design with user value ``value`` at K poses (1 = optimal)."""
@@ -196,15 +210,15 @@ class ApproxDesign:
         return d
 
 
-def _mass_value(criterion, loss, K, p):
-    """User value at mass K from the internal loss at mass 1."""
+def _mass_value(criterion, loss, K, p, unit="rad"):
+    """User value at mass K from the internal loss at mass 1 (``unit``: the zero offsets' internal unit)."""
     if not math.isfinite(loss):
-        return _user_value(criterion, math.inf)
+        return _user_value(criterion, math.inf, unit)
     if criterion == "D":
         return -loss + p * math.log(K)
     if criterion == "E":  # loss = -log lambda_min after e_certificate conversion
         return math.exp(-loss) * K
-    return _user_value(criterion, loss - math.log(K))
+    return _user_value(criterion, loss - math.log(K), unit)
 
 
 def _efficiency(criterion, value, bound, p):
@@ -239,15 +253,23 @@ def _e_loss(sol):
 
 
 def _clusters(X, w, radius, min_frac=1e-4):
-    """Support clusters: weights above ``min_frac`` of the largest, merged within ``radius`` into the heaviest."""
+    """Support clusters: weights above ``min_frac`` of the largest, merged within ``radius`` into the heaviest.
+
+    ``radius``: a number (mm), or one per coordinate (a box of mixed units: the points within the ellipsoid of
+    these half-axes).
+    """
     order = np.argsort(-w)
     keep = order[w[order] >= min_frac * w[order[0]]]
     reps, ws = [], []
+    per_axis = np.ndim(radius) > 0
     for k in keep:
         if reps:
-            dist = np.linalg.norm(np.array(reps) - X[k], axis=1)
+            if per_axis:
+                dist = np.linalg.norm((np.array(reps) - X[k]) / radius, axis=1)
+            else:
+                dist = np.linalg.norm(np.array(reps) - X[k], axis=1)
             j = int(np.argmin(dist))
-            if dist[j] <= radius:
+            if dist[j] <= (1.0 if per_axis else radius):
                 ws[j] += w[k]
                 continue
         reps.append(X[k])
@@ -288,6 +310,13 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     cons = cons or make_constraints(robot)
     wts = _criterion_weights(robot, criterion, tolerances) if criterion == "position" else Weights(robot, tolerances)
     X, h = candidate_poses(robot, cons, n_candidates)
+    if np.ndim(h):
+        k = int(round(float((cons.region.hi[0] - cons.region.lo[0]) / h[0]))) + 1
+        grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X)} feasible poses)"
+    else:
+        grid = f"a grid over the region, {h:.3g} mm apart ({len(X)} feasible poses)"
+    candidates = (f"{grid} and {refine} round{'s' if refine != 1 else ''} of local refinement around the "
+                  "measure's support: the bound covers designs on these candidates, not every pose of the region")
     model = PoseModel(robot, X, noise, criterion, wts)
     p = model.aq.shape[1]
     exact, enlarged = _windows(model.rho, cons)
@@ -362,4 +391,6 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     return ApproxDesign(criterion=criterion, X=sub.X, w=sol["w"], support=reps, support_w=ws, eff_lb=float(eff),
                         loss=loss, bound_loss=bound_loss, window=win, n_candidates=len(model.X), iterations=iters,
                         windows=len(exact), p=p, time_s=time.perf_counter() - t0,
-                        info={"grid_mm": h, "refine_rounds": refine, "q": sol["q"]})
+                        info={"grid_mm": h if np.ndim(h) == 0 else np.asarray(h).tolist(), "refine_rounds": refine,
+                              "q": sol["q"], "candidates": candidates},
+                        unit=robot.errors.offset_unit)

@@ -18,10 +18,12 @@ Constraints
 * singularity margin: every ``|sin|`` of a transmission angle (every
   singularity indicator of the mechanism) at least ``singularity_margin``
   (default: the robot's, 0.2);
-* optional joint limits (deg) on the inverse-kinematics angles, one
+* optional joint limits on the inverse-kinematics joints, in the joints'
+  file unit (deg for revolute joints, mm for prismatic ones), one
   ``(lo, hi)`` per joint, shape (m, 2);
 * distinct poses: pairwise distance at least ``min_separation_mm`` (default
-  1 mm; the data loader rejects repeated poses).
+  1 mm; the data loader rejects repeated poses); for a pose with orientations
+  a degree counts as a millimetre (:func:`zerocal_sym.design.terms.pose_distances`).
 
 This module holds :class:`Constraints`, :func:`make_constraints` and the
 feasibility checks (:func:`check_design`, per pose, of the travel); the
@@ -36,13 +38,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
-from zerocal_sym.model.kinematics import fmt_pose
-from zerocal_sym.design.terms import _call_ik, _reachable, pose_terms
+from zerocal_sym.model import units
+from zerocal_sym.model.kinematics import fmt_user_pose
+from zerocal_sym.design.terms import _call_ik, _reachable, pose_distances, pose_terms, poses_from_user, poses_to_user
 from zerocal_sym.design.limits import SCALE_RANGE_MM, TRAVEL_MODES, _FEAS_TOL, DesignError, _finite
 from zerocal_sym.design.shapes import make_region
 
 #: tolerance of the pointwise checks (poses computed on a rim, rw cos t, may be 1e-13 mm outside)
 _POINT_TOL = 1e-9
+
+
+def _fp(robot, p) -> str:
+    """A pose for messages, file units rounded to 3 decimals, with its unit (``(x, y) mm``)."""
+    return fmt_user_pose(robot, poses_from_user(robot, np.round(poses_to_user(robot, p), 3)))
+
+
+def region_text(region) -> str:
+    """A region's description with its unit (``... mm``; a box of mixed units names its own)."""
+    u = getattr(region, "units", None)
+    return region.describe() + ("" if u is not None and set(u) != {"mm"} else " mm")
 
 
 @dataclass(frozen=True)
@@ -57,46 +71,67 @@ class Constraints:
     travel_mode : {"range", "consecutive"}
     singularity_margin : float
         Lower bound on every ``|sin|`` of a transmission angle.
-    joint_limits_deg : tuple of m (lo, hi) pairs or None
-        Limits of the joints in the mechanism's order, deg.
+    joint_limits : tuple of m (lo, hi) pairs or None
+        Limits of the joints in the mechanism's order, in the joints' file unit ``joint_unit``.
     min_separation_mm : float
         Lower bound on the distance between any two poses, mm.
     mode_signs : tuple of float or None
         For a reachable region: the signs of the singularity indicators at
         home; the margin is then signed (``sign_i s_i >= margin``) and the
         forward kinematics must return the pose.
+    joint_unit : {"deg", "mm"}
+        The joints' file unit (of ``joint_limits``).
     """
 
     region: object
     travel_mm: float = SCALE_RANGE_MM
     travel_mode: str = "range"
     singularity_margin: float = 0.2
-    joint_limits_deg: tuple | None = None
+    joint_limits: tuple | None = None
     min_separation_mm: float = 1.0
     mode_signs: tuple | None = None
+    joint_unit: str = "deg"
+
+    @property
+    def joint_limits_deg(self):
+        """The joint limits of revolute joints, deg (their former name; None for prismatic joints)."""
+        return self.joint_limits if self.joint_unit == "deg" else None
+
+    def joint_limits_internal(self):
+        """The joint limits in internal units (rad, mm), ndarray shape (m, 2), or None."""
+        if self.joint_limits is None:
+            return None
+        from zerocal_sym.model.units import from_user
+
+        return from_user(np.asarray(self.joint_limits, float), "rad" if self.joint_unit == "deg" else "mm")
 
     def to_dict(self):
         clip = getattr(self.region, "clip", None)
-        return {"region_kind": self.region.kind, "region_mm": self.region.as_list(),
+        units_ = getattr(self.region, "units", None)
+        values = ({"region_mm": self.region.as_list()} if units_ is None or set(units_) == {"mm"}
+                  else {"region_values": self.region.as_list(), "region_units": list(units_)})
+        return {"region_kind": self.region.kind, **values,
                 "region_clip": None if clip is None else clip.kind,
                 "region": self.region.describe(), "travel_mm": self.travel_mm, "travel_mode": self.travel_mode,
                 "singularity_margin": self.singularity_margin,
-                "joint_limits_deg": None if self.joint_limits_deg is None else [list(j) for j in self.joint_limits_deg],
+                f"joint_limits_{self.joint_unit}": None if self.joint_limits is None
+                else [list(j) for j in self.joint_limits],
                 "min_separation_mm": self.min_separation_mm}
 
 
 
 def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="range",
                      singularity_margin=None, joint_limits_deg=None, min_separation_mm=1.0,
-                     bounds=None) -> Constraints:
+                     bounds=None, joint_limits=None) -> Constraints:
     """Validated :class:`Constraints`.
 
     Parameters
     ----------
     robot : Robot
-    region : Region, CylinderRegion, sequence of numbers in mm, "reachable", ("polygon", ...), optional
-        ``(XMIN, XMAX, YMIN, YMAX)`` for a rectangular workspace,
-        ``(RW, ZMIN, ZMAX)`` for a cylindrical one (:func:`make_region`).
+    region : Region, CylinderRegion, BoxRegion, sequence of numbers, "reachable", ("polygon", ...), optional
+        ``(XMIN, XMAX, YMIN, YMAX)`` (mm) for a rectangular workspace,
+        ``(RW, ZMIN, ZMAX)`` (mm) for a cylindrical one, ``(X_MIN, X_MAX, ...,
+        YAW_MIN, YAW_MAX)`` (mm, deg for orientations) for a box (:func:`make_region`).
         Default: the robot's workspace.  It must be reachable everywhere (a
         grid is checked: inverse kinematics defined and consistent with
         forward kinematics, i.e. one assembly mode).  ``"reachable"`` (with
@@ -108,8 +143,12 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
     travel_mode : {"range", "consecutive"}
     singularity_margin : float, optional
         Default ``robot.singularity_margin``.
-    joint_limits_deg : sequence of m (lo, hi) pairs, deg, optional
+    joint_limits : sequence of m (lo, hi) pairs, optional
+        In the joints' file unit: deg for revolute joints, mm for prismatic ones.
+    joint_limits_deg : sequence of m (lo, hi) pairs, optional
+        The same for revolute joints (its former name); for prismatic joints an error naming ``joint_limits``.
     min_separation_mm : float
+        mm; for a pose with orientations a degree counts as a mm.
 
     Raises
     ------
@@ -125,29 +164,39 @@ def make_constraints(robot, region=None, travel_mm=SCALE_RANGE_MM, travel_mode="
                                                                                  singularity_margin)
     if not 0 <= margin < 1:
         raise DesignError(f"singularity margin must be in [0, 1) (a |sin|), got {margin:g}")
+    ju = units.joint_unit(robot)
     if joint_limits_deg is not None:
+        if ju != "deg":
+            raise DesignError(f"joint limits in degrees do not fit robot {robot.name!r}: its joints "
+                              f"{', '.join(robot.mechanism.joint_names)} are prismatic: give joint_limits in mm")
+        if joint_limits is not None:
+            raise DesignError("joint limits given twice (joint_limits and joint_limits_deg)")
+        joint_limits = joint_limits_deg
+    if joint_limits is not None:
         m = robot.m
         try:
-            jl = np.asarray(joint_limits_deg, dtype=float)
+            jl = np.asarray(joint_limits, dtype=float)
         except (TypeError, ValueError):
             jl = None
         if jl is None or jl.shape != (m, 2) or not np.all(np.isfinite(jl)):
             pairs = ", ".join(f"(lo{i + 1}, hi{i + 1})" for i in range(m))
-            raise DesignError(f"joint limits must be ({pairs}) in degrees, finite, one pair per joint "
+            what = "degrees" if ju == "deg" else "mm"
+            raise DesignError(f"joint limits must be ({pairs}) in {what}, finite, one pair per joint "
                               f"({', '.join(robot.mechanism.joint_names)})")
         if np.any(jl[:, 0] >= jl[:, 1]):
-            raise DesignError(f"joint limits need lo < hi, got {jl.tolist()} deg")
-        joint_limits_deg = tuple(tuple(float(v) for v in row) for row in jl)
+            raise DesignError(f"joint limits need lo < hi, got {jl.tolist()} {ju}")
+        joint_limits = tuple(tuple(float(v) for v in row) for row in jl)
     min_sep = _finite("minimum pose separation", min_separation_mm)
     if min_sep < 0:
         raise DesignError(f"minimum pose separation must be >= 0 mm, got {min_sep:g}")
-    region = make_region(robot, region, bounds, margin, joint_limits_deg)
+    jl_int = None if joint_limits is None else units.joints_from_user(robot, np.asarray(joint_limits, float))
+    region = make_region(robot, region, bounds, margin, jl_int)
     signs = None
     if region.kind == "reachable":
         from zerocal_sym.design.regions import mode_signs
 
         signs = tuple(float(v) for v in mode_signs(robot))
-    cons = Constraints(region, travel_mm, travel_mode, margin, joint_limits_deg, min_sep, signs)
+    cons = Constraints(region, travel_mm, travel_mode, margin, joint_limits, min_sep, signs, ju)
     if signs is None:
         _check_region_reachable(robot, region)
     return cons
@@ -159,12 +208,12 @@ def _check_region_reachable(robot, region):
     bad = np.flatnonzero(~_reachable(ratio, th))
     ws = f"the robot's workspace is {robot.workspace.describe()} mm"
     if bad.size:
-        raise DesignError(f"region {region.describe()} mm is not reachable: {fmt_pose(grid[bad[0]])} mm cannot "
+        raise DesignError(f"region {region_text(region)} is not reachable: {_fp(robot, grid[bad[0]])} cannot "
                           f"be reached ({bad.size} of {len(grid)} grid points unreachable); {ws}")
     back = kin.fk(robot, th)
     off = np.flatnonzero(~(np.linalg.norm(back - grid, axis=1) < 1e-6))
     if off.size:
-        raise DesignError(f"region crosses an assembly-mode change at {fmt_pose(grid[off[0]])} mm "
+        raise DesignError(f"region crosses an assembly-mode change at {_fp(robot, grid[off[0]])} "
                           f"(forward and inverse kinematics disagree there); {ws}")
 
 
@@ -187,11 +236,11 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
     r = cons.region
     inside = r.contains(P, tol)
     for k in np.flatnonzero(~inside):
-        out.append(f"pose {k} {fmt_pose(np.round(P[k], 3))} mm is outside the region {r.describe()}")
+        out.append(f"pose {k} {_fp(robot, P[k])} is outside the region {r.describe()}")
     th, ratio = _call_ik(robot, P)
     unreach = ~_reachable(ratio, th)
     for k in np.flatnonzero(unreach):
-        out.append(f"pose {k} {fmt_pose(np.round(P[k], 3))} mm is unreachable")
+        out.append(f"pose {k} {_fp(robot, P[k])} is unreachable")
     if np.any(unreach):
         return out
     t = pose_terms(robot, P)
@@ -206,16 +255,17 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
                        f"{cons.singularity_margin:g} (the home pose's modes)")
         back = kin.fk(robot, t["theta"])
         for k in np.flatnonzero(~(np.linalg.norm(back - P, axis=1) < 1e-6)):
-            out.append(f"pose {k} {fmt_pose(np.round(P[k], 3))} mm: forward kinematics gives another assembly "
+            out.append(f"pose {k} {_fp(robot, P[k])}: forward kinematics gives another assembly "
                        "mode")
-    if cons.joint_limits_deg is not None:
-        jl = np.asarray(cons.joint_limits_deg)
-        deg = np.degrees(t["theta"])
+    if cons.joint_limits is not None:
+        jl = np.asarray(cons.joint_limits)
+        ju = cons.joint_unit
+        val = units.joints_to_user(robot, t["theta"])
         names = robot.mechanism.joint_names
         for k in range(len(P)):
             for i, name in enumerate(names):
-                if deg[k, i] < jl[i, 0] - tol or deg[k, i] > jl[i, 1] + tol:
-                    out.append(f"pose {k}: {name} = {deg[k, i]:.4f} deg outside [{jl[i, 0]:g}, {jl[i, 1]:g}]")
+                if val[k, i] < jl[i, 0] - tol or val[k, i] > jl[i, 1] + tol:
+                    out.append(f"pose {k}: {name} = {val[k, i]:.4f} {ju} outside [{jl[i, 0]:g}, {jl[i, 1]:g}]")
     rho = t["rho"]
     if cons.travel_mode == "range":
         if np.ptp(rho) > cons.travel_mm + tol:
@@ -225,7 +275,7 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
         for k in np.flatnonzero(d > cons.travel_mm + tol):
             out.append(f"scale travel: |rho_{k + 1} - rho_{k}| = {d[k]:.3f} mm > l0 = {cons.travel_mm:g} mm")
     if cons.min_separation_mm > 0 and len(P) > 1:
-        dist = np.linalg.norm(P[:, None] - P[None], axis=2)
+        dist = pose_distances(robot, P)
         iu = np.triu_indices(len(P), 1)
         close = np.flatnonzero(dist[iu] < cons.min_separation_mm - tol)
         for c in close:
@@ -242,7 +292,7 @@ def _pointwise_ok(robot, P, cons: Constraints):
 
         ok = cons.region.contains(P, _POINT_TOL)
         if np.any(ok):
-            jl = None if cons.joint_limits_deg is None else np.radians(np.asarray(cons.joint_limits_deg))
+            jl = cons.joint_limits_internal()
             ok[np.flatnonzero(ok)] = _feasible(robot, P[ok], cons.singularity_margin, jl,
                                                np.asarray(cons.mode_signs))
         return ok
@@ -252,8 +302,8 @@ def _pointwise_ok(robot, P, cons: Constraints):
         return ok
     t = pose_terms(robot, P[ok])
     good = np.min(np.abs(t["s"]), axis=1) >= cons.singularity_margin + 1e-9
-    if cons.joint_limits_deg is not None:
-        jl = np.radians(np.asarray(cons.joint_limits_deg))
+    if cons.joint_limits is not None:
+        jl = cons.joint_limits_internal()
         good &= np.all((t["theta"] >= jl[:, 0] + 1e-9) & (t["theta"] <= jl[:, 1] - 1e-9), axis=1)
     ok[np.flatnonzero(ok)] = good
     return ok

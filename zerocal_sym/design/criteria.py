@@ -60,10 +60,12 @@ import math
 import numpy as np
 
 from zerocal_sym.errors import PoseError
+from zerocal_sym.model import units
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.constraints import Constraints, check_design
-from zerocal_sym.design.terms import Weights, _crlb_weights, _qscale, design_params, pose_terms
+from zerocal_sym.design.terms import (Weights, _crlb_weights, _qscale, design_params, noise_dict, offset_unit,
+                                      offsets_to_user, okey, pose_terms, pose_units, poses_to_user)
 
 #: criterion name -> (description, units, better: "min" | "max"); p = m + n parameters
 #: (:func:`criteria_table` gives the table of one robot, with its names and p)
@@ -95,15 +97,19 @@ def criteria_table(robot) -> dict:
     names = design_params(robot)
     q = ", ".join(f"{errors[nm].lever} d{nm}" if errors[nm].lever else nm for nm in names)
     m = len(errors.zero_offsets)
+    u = offset_unit(robot)
     out = dict(CRITERIA)
     out["D"] = (f"log det of the Fisher information F_q (q = {q})", f"log(1/mm^{2 * len(names)})", "max")
-    out["crlb"] = (f"RMS Cramer-Rao bound of the {m} zero offsets (full noise model)", "deg", "min")
+    out["crlb"] = (f"RMS Cramer-Rao bound of the {m} zero offsets (full noise model)", u, "min")
+    out["mse"] = (CRITERIA["mse"][0], u, "min")
     return out
 
 
-def _noise_terms(noise: NoiseModel):
+def _noise_terms(noise: NoiseModel, robot=None):
+    """``(sigma_m^2, sigma_joint^2)`` (mm^2; the joints' internal unit squared); ``noise`` None: the robot's
+    (:attr:`Robot.noise`; the paper's without a robot)."""
     if noise is None:
-        noise = NoiseModel.paper()
+        noise = NoiseModel.paper() if robot is None else robot.noise
     if noise.is_zero:
         raise DesignError("the noise model is zero: the Fisher information is unbounded")
     return float(noise.sigma_scale_mm) ** 2, float(noise.sigma_servo_rad) ** 2
@@ -256,7 +262,7 @@ def criterion_values(robot, P, noise: NoiseModel | None = None, tolerances=None)
         ``crlb`` (deg, RMS over the m offsets), ``position`` (mm), ``mse``
         (deg); ``inf``/``-inf`` where the design is rank-deficient.
     """
-    sm2, _ = _noise_terms(noise)
+    sm2, _ = _noise_terms(noise, robot)
     w = _crlb_weights(robot)
     wt = Weights(robot, tolerances)
     aq, v, ao = _terms_batch(robot, P, noise, omitted=True)
@@ -266,12 +272,13 @@ def criterion_values(robot, P, noise: NoiseModel | None = None, tolerances=None)
             o = float(_objective_batch(c, wt.extend(aq, ao), v, sm2, wt)[0])
         else:
             o = float(_objective_batch(c, aq, v, sm2, wt if c == "position" else w)[0])
-        res[c] = _user_value(c, o)
+        res[c] = _user_value(c, o, robot.errors.offset_unit)
     return res
 
 
-def _user_value(criterion, obj):
-    """Internal objective -> user-facing value."""
+def _user_value(criterion, obj, unit: str = "rad"):
+    """Internal objective -> user-facing value (``unit``: the zero offsets' internal unit, rad or mm, of the
+    ``crlb`` and ``mse`` criteria; their values are in its file unit, deg or mm)."""
     if not np.isfinite(obj):
         return {"cond": math.inf, "D": -math.inf, "A": math.inf, "E": 0.0, "crlb": math.inf,
                 "position": math.inf, "mse": math.inf}[criterion]
@@ -285,7 +292,7 @@ def _user_value(criterion, obj):
         return math.exp(obj)
     if criterion == "E":
         return math.exp(-obj)
-    return math.degrees(math.sqrt(math.exp(obj)))
+    return float(units.to_user(math.sqrt(math.exp(obj)), unit))
 
 
 # --------------------------------------------------------------------------- evaluation
@@ -302,10 +309,13 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     Returns
     -------
     dict
-        ``poses`` (K x n mm), ``joints_deg`` (K x m), ``pose_names``,
-        ``joint_names``, ``criterion`` {``name``, ``value``, ``units``,
+        ``poses`` (K x n, file units: mm, deg for orientations, as
+        ``pose_units`` says), ``joints_deg`` (K x m; ``joints_mm`` for
+        prismatic joints: every key of a joint quantity names the joints'
+        file unit, :func:`zerocal_sym.design.terms.okey`), ``pose_names``,
+        ``joint_names``, ``joint_unit``, ``criterion`` {``name``, ``value``, ``units``,
         ``values`` (all seven), ``units_all``}, ``crlb_zero_offsets_deg`` (m,)
-        from :func:`zerocal_sym.identify.fisher.crlb_zero_offsets_deg` and
+        from :func:`zerocal_sym.identify.fisher.crlb_zero_offsets_user` and
         its RMS ``crlb_rms_deg``, ``bias`` (worst-case and RMS bias of the
         zero offsets from the tolerances, :func:`zerocal_sym.identify.bias.tolerance_bias`,
         and the RMS error ``sqrt(CRLB^2 + RMS bias^2)`` per offset),
@@ -323,21 +333,23 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     vals = criterion_values(robot, P, noise, tolerances)
     t = pose_terms(robot, P)
     try:
-        crlb = fisher.crlb_zero_offsets_deg(robot, t["theta"], "paper", noise).tolist()
+        crlb = fisher.crlb_zero_offsets_user(robot, t["theta"], "paper", noise).tolist()
     except PoseError:
         crlb = [math.inf] * robot.m
     bias_rep = _bias_report(robot, t["theta"], noise, tolerances, crlb)
     pos = position_report(robot, P, noise)
     G, _ = identification_matrix(robot, P, theta=t["theta"])
     rep = {
-        "poses": P.tolist(),
-        "joints_deg": np.degrees(t["theta"]).tolist(),
+        "poses": poses_to_user(robot, P).tolist(),
+        "pose_units": pose_units(robot),
+        okey(robot, "joints"): offsets_to_user(robot, t["theta"]).tolist(),
         "pose_names": list(robot.mechanism.pose_names),
         "joint_names": list(robot.mechanism.joint_names),
+        "joint_unit": offset_unit(robot),
         "criterion": {"name": criterion, "value": vals[criterion], "units": table[criterion][1],
                       "values": vals, "units_all": {c: table[c][1] for c in table}},
-        "crlb_zero_offsets_deg": crlb,
-        "crlb_rms_deg": float(np.sqrt(np.mean(np.square(crlb)))),
+        okey(robot, "crlb_zero_offsets"): crlb,
+        okey(robot, "crlb_rms"): float(np.sqrt(np.mean(np.square(crlb)))),
         "bias": bias_rep,
         "position": pos,
         "kappa": condition_number(G),
@@ -350,19 +362,23 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
 
 
 def _bias_report(robot, theta, noise, tolerances, crlb):
-    """The zero offsets' bias from the tolerances (deg) and the RMS error with the CRLB."""
+    """The zero offsets' bias from the tolerances and the RMS error with the CRLB (the offsets' file unit:
+    keys ``worst_case_deg`` ... for revolute joints, ``worst_case_mm`` ... for prismatic ones)."""
     from zerocal_sym.identify import bias
 
     try:
         b = bias.tolerance_bias(robot, theta, tolerances, "paper", noise)
     except (np.linalg.LinAlgError, ValueError):
         return None
-    z = b["zero_offsets"]
-    rms_err = np.sqrt(np.square(crlb) + np.square(z["rms_deg"]))
-    return {"worst_case_deg": z["worst_case_deg"], "rms_deg": z["rms_deg"],
-            "worst_case_rms_deg": float(np.sqrt(np.mean(np.square(z["worst_case_deg"])))),
-            "rms_rms_deg": float(np.sqrt(np.mean(np.square(z["rms_deg"])))),
-            "rms_error_deg": rms_err.tolist(), "rms_error_rms_deg": float(np.sqrt(np.mean(rms_err ** 2))),
+    off = [b["params"].index(z) for z in robot.errors.zero_offsets]
+    worst = np.asarray(b["worst_case"], float)[off]
+    rms = np.asarray(b["rms"], float)[off]
+    rms_err = np.sqrt(np.square(crlb) + np.square(rms))
+    k = lambda stem: okey(robot, stem)  # noqa: E731
+    return {k("worst_case"): worst.tolist(), k("rms"): rms.tolist(),
+            k("worst_case_rms"): float(np.sqrt(np.mean(np.square(worst)))),
+            k("rms_rms"): float(np.sqrt(np.mean(np.square(rms)))),
+            k("rms_error"): rms_err.tolist(), k("rms_error_rms"): float(np.sqrt(np.mean(rms_err ** 2))),
             "tolerances": b["tolerances"], "tolerance_units": b["tolerance_units"], "model": b["model"]}
 
 
@@ -383,7 +399,7 @@ def position_report(robot, P, noise=None) -> dict:
     from zerocal_sym.design.terms import offset_positions, position_jacobians
 
     P = np.atleast_2d(np.asarray(P, float))
-    sm2, _ = _noise_terms(noise)
+    sm2, _ = _noise_terms(noise, robot)
     aq, v = _terms_batch(robot, P, noise)
     F = _fisher(aq, v, sm2)[0]
     grid, J = position_jacobians(robot)
@@ -408,7 +424,7 @@ def _check_criterion(criterion):
 
 def _terms_batch(robot, P, noise, omitted=False):
     """``aq`` (1, K, p), ``v`` (1, K) [, ``ao`` (1, K, r) with ``omitted``]."""
-    _, sx2 = _noise_terms(noise)
+    _, sx2 = _noise_terms(noise, robot)
     t = pose_terms(robot, P)
     out = (t["a"] * _qscale(robot))[None], (sx2 * np.sum(t["dth"] ** 2, axis=1))[None]
     return out + (t["ao"][None],) if omitted else out
@@ -435,6 +451,6 @@ def _objective(robot, criterion, P, noise, tolerances=None):
         aq, v, ao = _terms_batch(robot, P, noise, omitted=True)
         if criterion in EXTENDED:
             aq = wt.extend(aq, ao)
-        return float(_objective_batch(criterion, aq, v, _noise_terms(noise)[0], wt)[0])
-    return float(_objective_batch(criterion, *_terms_batch(robot, P, noise), _noise_terms(noise)[0],
+        return float(_objective_batch(criterion, aq, v, _noise_terms(noise, robot)[0], wt)[0])
+    return float(_objective_batch(criterion, *_terms_batch(robot, P, noise), _noise_terms(noise, robot)[0],
                                   _crlb_weights(robot))[0])

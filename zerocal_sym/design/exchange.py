@@ -14,7 +14,7 @@ from zerocal_sym.design.limits import DesignError, _check_k
 from zerocal_sym.design.constraints import Constraints, _feasible_random_subset, _pointwise_ok, make_constraints
 from zerocal_sym.design.criteria import (_check_criterion, _criterion_terms, _criterion_weights, _noise_terms,
                                          _objective_batch, _user_value)
-from zerocal_sym.design.terms import _qscale, pose_terms
+from zerocal_sym.design.terms import _qscale, pose_distances, pose_terms
 
 
 # --------------------------------------------------------------------------- discrete exchange
@@ -63,7 +63,7 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         raise DesignError(f"only {len(cand)} feasible candidate poses in the region on a "
                           f"{' x '.join(str(g) for g in grid)} grid (K = {K} needed): relax the singularity "
                           "margin or joint limits, or enlarge the region")
-    sm2, sx2 = _noise_terms(noise)
+    sm2, sx2 = _noise_terms(noise, robot)
     qs = _qscale(robot)
     wc = _criterion_weights(robot, criterion, tolerances)
     t = pose_terms(robot, cand)
@@ -73,7 +73,7 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
     N = len(cand)
     close = None
     if cons.min_separation_mm > 0:
-        close = np.linalg.norm(cand[:, None] - cand[None], axis=2) < cons.min_separation_mm
+        close = pose_distances(robot, cand) < cons.min_separation_mm
         np.fill_diagonal(close, False)
     best_idx, best_o, starts = None, np.inf, []
     for _ in range(n_starts):
@@ -106,5 +106,5 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
             best_idx, best_o = idx.copy(), cur
     if not np.isfinite(best_o):
         raise DesignError("every exchange start is rank-deficient: the region cannot identify the parameters")
-    return {"poses": cand[best_idx], "objective": float(best_o), "value": _user_value(criterion, best_o),
+    return {"poses": cand[best_idx], "objective": float(best_o), "value": _user_value(criterion, best_o, robot.errors.offset_unit),
             "starts": starts, "n_candidates": int(N), "grid": list(grid), "time_s": time.perf_counter() - t0}

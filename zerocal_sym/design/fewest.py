@@ -14,14 +14,19 @@ from typing import TYPE_CHECKING
 from zerocal_sym.design.constraints import Constraints, make_constraints
 from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.rounding import realize
+from zerocal_sym.design.terms import offset_unit, offsets_from_user, okey
 
 if TYPE_CHECKING:
     from zerocal_sym.design.approx import ApproxDesign
 
 
-def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, noise=None, k_max: int | None = None,
+def fewest_poses(robot, target: float, cons: Constraints | None = None, noise=None, k_max: int | None = None,
                  ad: ApproxDesign | None = None):
-    """The fewest poses K whose design reaches an RMS zero-offset CRLB of ``target_deg``, with the bound.
+    """The fewest poses K whose design reaches an RMS zero-offset CRLB of ``target``, with the bound.
+
+    ``target`` is in the zero offsets' file unit: deg for revolute joints, mm for prismatic ones
+    (:func:`zerocal_sym.design.terms.offset_unit`); so are the CRLBs returned (keys ``target_crlb_deg``,
+    ``crlb_rms_deg``, or ``..._mm``).
 
     The crlb measure (:func:`~zerocal_sym.design.approx.approximate_design`) gives a certified lower
     bound: no ordered design of fewer than ``K_lower_bound`` poses on the
@@ -34,7 +39,7 @@ def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, nois
     Returns
     -------
     dict
-        ``K``, ``K_lower_bound``, ``target_crlb_deg``, ``crlb_rms_deg`` (of
+        ``K``, ``K_lower_bound``, ``unit``, ``target_crlb_deg``, ``crlb_rms_deg`` (of
         the returned design), ``poses`` (K, n), ``evaluated`` {K: crlb},
         ``approximate`` (the measure's summary), ``time_s``.
 
@@ -49,20 +54,23 @@ def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, nois
     from zerocal_sym.model.noise import NoiseModel
 
     t0 = time.perf_counter()
+    u = offset_unit(robot)
+    what = "degrees" if u == "deg" else "mm"
+    given = target
     try:
-        target = float(target_deg)
+        target = float(target)
     except (TypeError, ValueError):
-        raise DesignError(f"the target CRLB must be a number of degrees, got {target_deg!r}") from None
+        raise DesignError(f"the target CRLB must be a number of {what}, got {given!r}") from None
     if not (math.isfinite(target) and target > 0):
-        raise DesignError(f"the target CRLB must be positive and finite, got {target_deg!r} deg")
+        raise DesignError(f"the target CRLB must be positive and finite, got {given!r} {u}")
     noise = NoiseModel.coerce(noise, robot=robot)
     cons = cons or make_constraints(robot)
     k_max = MAX_K if k_max is None else int(k_max)
     ad = ad or approximate_design(robot, "crlb", cons, noise)
-    tr = math.radians(target) ** 2
+    tr = float(offsets_from_user(robot, target)) ** 2
     k_lb = max(min_k(robot), int(math.ceil(math.exp(ad.bound_loss) / tr * (1 - 1e-12))))
     if k_lb > k_max:
-        raise DesignError(f"a CRLB of {target:g} deg needs at least {k_lb} poses (certified), more than "
+        raise DesignError(f"a CRLB of {target:g} {u} needs at least {k_lb} poses (certified), more than "
                           f"the {k_max} allowed")
     evaluated = {}
     designs = {}
@@ -81,8 +89,8 @@ def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, nois
         lo = K
         K = min(k_max, max(K + 1, int(math.ceil(K * (v / target) ** 2))))
         if K == lo:
-            raise DesignError(f"no design of up to {k_max} poses reaches a CRLB of {target:g} deg "
-                              f"(at {k_max}: {v:.4g} deg)")
+            raise DesignError(f"no design of up to {k_max} poses reaches a CRLB of {target:g} {u} "
+                              f"(at {k_max}: {v:.4g} {u})")
         v = crlb_at(K)
     hi = K
     lo = k_lb - 1 if lo is None else lo
@@ -96,6 +104,7 @@ def fewest_poses(robot, target_deg: float, cons: Constraints | None = None, nois
     v = crlb_at(hi, n_orders=60)
     if v > target:  # the fuller order search never makes it worse than the short one; keep the short one
         v = min(x for k, x in evaluated.items() if k == hi)
-    return {"K": int(hi), "K_lower_bound": int(k_lb), "target_crlb_deg": target, "crlb_rms_deg": float(v),
+    return {"K": int(hi), "K_lower_bound": int(k_lb), "unit": u, okey(robot, "target_crlb"): target,
+            okey(robot, "crlb_rms"): float(v),
             "poses": designs[hi], "evaluated": {int(k): float(x) for k, x in sorted(evaluated.items())},
             "approximate": ad.to_dict(hi), "time_s": time.perf_counter() - t0}

@@ -19,7 +19,7 @@ from zerocal_sym.design.terms import Weights, _qscale, pose_terms
 
 def _mse_terms(robot, X, noise, tolerances):
     """Regressors of the pose model with the omitted errors: (G_theta (N, 1 + p), G_o (N, r), W~ (1 + p,))."""
-    sm2, sx2 = _noise_terms(noise)
+    sm2, sx2 = _noise_terms(noise, robot)
     t = pose_terms(robot, X)
     wts = Weights(robot, tolerances)
     vt = sx2 * np.sum(t["dth"] ** 2, axis=1) + sm2 / 4.0
@@ -93,10 +93,11 @@ def mse_measure(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None
             break
         w, f, g = wn, fn, gg
         eta = min(eta * 2, 1e3)
-    h = ad.info.get("grid_mm", 1.0) / 3 ** ad.info.get("refine_rounds", 0)
+    h = ad.info.get("grid_mm", 1.0)
+    h = (h if np.ndim(h) == 0 else np.asarray(h, float)) / 3 ** ad.info.get("refine_rounds", 0)
     reps, ws = _clusters(X, w, 1.5 * h)
     out = ApproxDesign(criterion="mse", X=X, w=w, support=reps, support_w=ws, eff_lb=math.nan,
                        loss=math.log(f * K), bound_loss=math.nan, window=ad.window, n_candidates=ad.n_candidates,
                        iterations=ad.iterations, windows=ad.windows, p=ad.p, time_s=ad.time_s,
-                       info=dict(ad.info, start="crlb measure", K=K))
+                       info=dict(ad.info, start="crlb measure", K=K), unit=ad.unit)
     return out

@@ -43,7 +43,8 @@ from zerocal_sym.design.constraints import (Constraints, _feasible_random_subset
                                             make_constraints)
 from zerocal_sym.design.criteria import (EXTENDED, _check_criterion, _criterion_weights, _fisher_batch,
                                          _noise_terms, _objective, _objective_batch, _terms_batch, _user_value)
-from zerocal_sym.design.terms import Weights, _crlb_weights, _pose_terms_fn, _qscale, pose_terms
+from zerocal_sym.design.terms import (Weights, _crlb_weights, _pose_terms_fn, _qscale, _user_scale, pose_distances,
+                                      pose_terms)
 
 #: formulation of the matrix inequalities per criterion for p <= 4 (measured best, see module docstring)
 PSD_FORM = {"E": "minors", "cond": "chol"}
@@ -69,16 +70,34 @@ def _minors(M):
     return out
 
 
+#: a mechanism whose per-pose terms have more expression nodes than this (the hexapod's, its forward kinematics
+#: by Newton steps inside the distance model: 58588; the planar robot's 294, the Deltas' 829 and 1600) gets the
+#: large form of the NLP (:func:`nlp_form`)
+LARGE_TERMS_NODES = 20000
+
+
+def nlp_form(robot) -> str:
+    """``"exact"`` (exact Hessian of the Lagrangian) or ``"large"`` for a mechanism whose per-pose terms exceed
+    :data:`LARGE_TERMS_NODES` nodes: a limited-memory (L-BFGS) Hessian.  For the hexapod at K = 16 the exact
+    Hessian took 291 s to build and 69 s to solve from the 16-corner fraction, L-BFGS about 30 s and 10 s (and
+    reached a lower CRLB, 0.0369 against 0.0376 mm); the terms as one mapped MX call built in 20 s but its
+    constraint Jacobian took 370 s over the solve (docs/design.md)."""
+    return "large" if _pose_terms_fn(robot.mechanism_name).n_nodes() > LARGE_TERMS_NODES else "exact"
+
+
 class _NLP:
     """The symbolic design NLP for one (robot, K, criterion, constraints, noise)."""
 
     def __init__(self, robot, K, criterion, cons: Constraints, noise, fscale, mscale, max_iter=500,
-                 psd_form=None, ipopt_options=None, tolerances=None):
+                 psd_form=None, ipopt_options=None, tolerances=None, form=None):
         import casadi as ca
 
+        form = form or nlp_form(robot)
+        self.form = form
+        X = ca.SX
         self.robot, self.K, self.criterion, self.cons = robot, K, criterion, cons
         self._need_B, self.wts = False, None
-        sm2, sx2 = _noise_terms(noise)
+        sm2, sx2 = _noise_terms(noise, robot)
         qs = _qscale(robot)
         wc = _crlb_weights(robot)
         wts = Weights(robot, tolerances) if criterion in ("position",) + EXTENDED else None
@@ -88,7 +107,7 @@ class _NLP:
         self.n = dim
         region = cons.region
         c, h = region.center, region.half
-        z = ca.SX.sym("z", dim, K)
+        z = X.sym("z", dim, K)
         P = ca.repmat(ca.DM(c), 1, K) + ca.repmat(ca.DM(h), 1, K) * z
         f = _pose_terms_fn(robot.mechanism_name).map(K)
         theta, ratio, s, rho, a, dth, ao = f(P, robot.geometry)
@@ -111,7 +130,7 @@ class _NLP:
         self.cells, self.p_sym = cells, None
         if cells:  # a polygon: each pose in a convex cell (its start's), half-planes a x + b y <= c as parameters
             hmax = max(len(c_) for c_ in cells)
-            par = ca.SX.sym("cells", 3 * hmax, K)
+            par = X.sym("cells", 3 * hmax, K)
             for j in range(hmax):
                 add(par[3 * j, :] * P[0, :] + par[3 * j + 1, :] * P[1, :] - par[3 * j + 2, :], -np.inf, 0.0)
             self.p_sym, self.hmax = ca.vec(par), hmax
@@ -119,14 +138,14 @@ class _NLP:
             add(s * ca.repmat(ca.DM(np.asarray(cons.mode_signs)), 1, K), cons.singularity_margin + 1e-7, np.inf)
         elif cons.singularity_margin > 0:
             add(s ** 2, (cons.singularity_margin + 1e-7) ** 2, np.inf)
-        if cons.joint_limits_deg is not None:
-            jl = np.radians(np.asarray(cons.joint_limits_deg))
+        if cons.joint_limits is not None:
+            jl = cons.joint_limits_internal()
             for i in range(robot.m):
                 add(theta[i, :], jl[i, 0] + 1e-9, jl[i, 1] - 1e-9)
         aux = []  # (name, symbol column, lb, ub, init(nums) -> values)
         l0 = cons.travel_mm
         if cons.travel_mode == "range":
-            r = ca.SX.sym("r", 2)  # rho window, scaled by 1/l0
+            r = X.sym("r", 2)  # rho window, scaled by 1/l0
             aux.append(("rho window", r, -np.inf, np.inf,
                         lambda n: np.array([n["rho"].min(), n["rho"].max()]) / l0))
             add(rho / l0 - r[0], 0, np.inf)
@@ -134,9 +153,11 @@ class _NLP:
             add(r[1] - r[0], -np.inf, 1 - 1e-9)
         else:
             add((rho[1:] - rho[:-1]) / l0, -1 + 1e-9, 1 - 1e-9)
-        if cons.min_separation_mm > 0:
-            d2 = [ca.sumsqr(P[:, i] - P[:, j]) / 1e4 for i in range(K) for j in range(i + 1, K)]
-            add(ca.vertcat(*d2), (cons.min_separation_mm + 1e-6) ** 2 / 1e4, np.inf)
+        if cons.min_separation_mm > 0:  # in file units (a degree of an orientation counts as a mm)
+            us = ca.DM(_user_scale(robot))
+            Pu = P * ca.repmat(us, 1, K)
+            d2 = ca.vertcat(*[ca.sumsqr(Pu[:, i] - Pu[:, j]) / 1e4 for i in range(K) for j in range(i + 1, K)])
+            add(d2, (cons.min_separation_mm + 1e-6) ** 2 / 1e4, np.inf)
 
         def psd(name, X, X0):
             """X (symbolic p x p) >= 0: principal minors, or X = L L^T with L lower-triangular (auxiliary)."""
@@ -144,8 +165,8 @@ class _NLP:
                 add(ca.vertcat(*_minors(X)), 0, np.inf)
                 return
             tri = [(i, j) for i in range(p) for j in range(i + 1)]
-            lv = ca.SX.sym(name, len(tri))
-            Lm = ca.SX.zeros(p, p)
+            lv = X.sym(name, len(tri))
+            Lm = X.zeros(p, p)
             for k, (i, j) in enumerate(tri):
                 Lm[i, j] = lv[k]
             R = X - Lm @ Lm.T
@@ -162,13 +183,13 @@ class _NLP:
         # differences and Fisher information (LDL^T of the tridiagonal covariance)
         b = [aq[:, i + 1] - aq[:, i] for i in range(K - 1)]
         if criterion == "cond":
-            M = sum((bi @ bi.T for bi in b), ca.SX.zeros(p, p)) / mscale
-            tl = ca.SX.sym("tlo")
-            th_ = ca.SX.sym("thi")
+            M = sum((bi @ bi.T for bi in b), X.zeros(p, p)) / mscale
+            tl = X.sym("tlo")
+            th_ = X.sym("thi")
             aux.append(("tlo", tl, 1e-12, np.inf, lambda n: max(0.5 * n["wM"][0], 1e-12)))
             aux.append(("thi", th_, 1e-12, np.inf, lambda n: 1.5 * n["wM"][-1]))
-            psd("Llo", M - tl * ca.SX.eye(p), lambda n: n["M"] - 0.5 * n["wM"][0] * np.eye(p))
-            psd("Lhi", th_ * ca.SX.eye(p) - M, lambda n: 1.5 * n["wM"][-1] * np.eye(p) - n["M"])
+            psd("Llo", M - tl * X.eye(p), lambda n: n["M"] - 0.5 * n["wM"][0] * np.eye(p))
+            psd("Lhi", th_ * X.eye(p) - M, lambda n: 1.5 * n["wM"][-1] * np.eye(p) - n["M"])
             obj = 0.5 * (ca.log(th_) - ca.log(tl))
         else:
             d = [sm2 + v[i] + v[i + 1] for i in range(K - 1)]
@@ -192,9 +213,9 @@ class _NLP:
             if criterion == "D":
                 obj = -ca.log(ca.det(Fn))
             elif criterion == "E":
-                tt = ca.SX.sym("t")
+                tt = X.sym("t")
                 aux.append(("t", tt, 1e-12, np.inf, lambda n: max(0.5 * n["wF"][0], 1e-12)))
-                psd("L", Fn - tt * ca.SX.eye(p), lambda n: n["Fn"] - 0.5 * n["wF"][0] * np.eye(p))
+                psd("L", Fn - tt * X.eye(p), lambda n: n["Fn"] - 0.5 * n["wF"][0] * np.eye(p))
                 obj = -ca.log(tt)
             else:
                 Finv = ca.inv(Fn)
@@ -209,7 +230,7 @@ class _NLP:
                     if wts.bias_model == "worst":  # (sum_k |B_jk|)^2 by an epigraph: -u <= B <= u, smooth
                         rows = [j for j in range(p) if wc[j] != 0]
                         r_ = Bm.shape[1]
-                        ub = ca.SX.sym("ub", len(rows), r_)
+                        ub = X.sym("ub", len(rows), r_)
                         Bsel = ca.vertcat(*[Bm[j, :] for j in rows])
                         add(ca.vec(ub - Bsel), 0, np.inf)
                         add(ca.vec(ub + Bsel), 0, np.inf)
@@ -238,6 +259,8 @@ class _NLP:
                 "ipopt.bound_relax_factor": 0.0, "error_on_fail": False, "show_eval_warnings": False}
         if criterion in ("cond", "E"):
             opts["ipopt.mu_init"] = 1e-6
+        if form == "large":
+            opts["ipopt.hessian_approximation"] = "limited-memory"
         opts.update(ipopt_options or {})
         prob = {"x": x, "f": obj, "g": ca.vertcat(*g)}
         if self.p_sym is not None:
@@ -306,7 +329,7 @@ def _random_start(robot, K, cons, rng, tries=50):
         rho = pose_terms(robot, pts)["rho"]
         close = None
         if cons.min_separation_mm > 0:
-            close = np.linalg.norm(pts[:, None] - pts[None], axis=2) < cons.min_separation_mm
+            close = pose_distances(robot, pts) < cons.min_separation_mm
             np.fill_diagonal(close, False)
         idx = _feasible_random_subset(rng, rho, K, cons, tries=20, close=close)
         if idx is None:
@@ -319,7 +342,7 @@ def _random_start(robot, K, cons, rng, tries=50):
 
 def _scales(robot, P, noise):
     """Normalisations of F_q and G^T G (mean eigenvalue at a reference design)."""
-    sm2, sx2 = _noise_terms(noise)
+    sm2, sx2 = _noise_terms(noise, robot)
     t = pose_terms(robot, P)
     aq = t["a"] * _qscale(robot)
     v = sx2 * np.sum(t["dth"] ** 2, axis=1)
@@ -370,7 +393,7 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
     if not all_starts:
         raise DesignError("could not find a feasible random start: the constraints leave (almost) no room")
     ref = next((P for _, P in all_starts if np.isfinite(_objective_batch(
-        "D", *_terms_batch(robot, P, noise), _noise_terms(noise)[0], _crlb_weights(robot))[0])), all_starts[0][1])
+        "D", *_terms_batch(robot, P, noise), _noise_terms(noise, robot)[0], _crlb_weights(robot))[0])), all_starts[0][1])
     fscale, mscale = _scales(robot, ref, noise)
     nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter, tolerances=tolerances)
     build_s = time.perf_counter() - t0
@@ -380,12 +403,12 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         P, status, iters = nlp.solve(P0)
         viol = check_design(robot, P, cons)
         o = _objective(robot, criterion, P, noise, tolerances)
-        runs.append({"start": label, "value": _user_value(criterion, o), "status": status, "iterations": iters,
+        runs.append({"start": label, "value": _user_value(criterion, o, robot.errors.offset_unit), "status": status, "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
         if not viol and np.isfinite(o) and (best is None or o < best[1]):
             best = (P, o)
     if best is None:
         raise DesignError("no Ipopt start ended at a feasible design; statuses: "
                           + ", ".join(sorted({r["status"] for r in runs})))
-    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1]), "runs": runs,
+    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1], robot.errors.offset_unit), "runs": runs,
             "time_s": time.perf_counter() - t0, "build_s": build_s, "nlp": nlp}

@@ -40,36 +40,50 @@ import numpy as np
 from zerocal_sym.io.files import json_safe
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import MAX_K_EXACT, DesignError, _check_k
-from zerocal_sym.design.shapes import CylinderRegion, Region, workspace_region
+from zerocal_sym.design.shapes import BoxRegion, CylinderRegion, Region, workspace_region
 from zerocal_sym.design.constraints import Constraints, check_design, make_constraints
 from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective, evaluate
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
+from zerocal_sym.design.terms import describe_noise, noise_dict
 
 
 # --------------------------------------------------------------------------- baseline
-def paper_baseline(robot, K: int, region: Region | CylinderRegion | None = None) -> np.ndarray:
+def scheme_parameter(workspace, K: int):
+    """The n whose boundary scheme has K poses (``workspace.scheme_size(n) == K``), or None.
+
+    K = 2n on a rectangle and a cylinder (even K); K = n on a box (the corner scheme: 64, 32 or 16).
+    """
+    return next((n for n in workspace.scheme_sizes(K) if workspace.scheme_size(n) == K), None)
+
+
+def paper_baseline(robot, K: int, region: Region | CylinderRegion | BoxRegion | None = None) -> np.ndarray:
     """The workspace's boundary scheme with K poses, as the baseline.
 
-    Even K on the whole workspace: ``robot.workspace.boundary_scheme(K // 2)``
-    -- the paper's scheme on a rectangle (``n = K/2`` poses on ``y = H`` then
-    on ``y = H + h``), the ring scheme on a cylinder (``n`` poses on the top
-    circle at azimuths ``360 deg j/n``, then on the bottom one).  On a smaller
-    region or for odd K (the paper has none) the same rule on the region's
-    boundaries with ``ceil(K/2)`` poses on the first (``y = ymin``; the top
-    circle) and ``floor(K/2)`` on the second (``y = ymax``; the bottom
-    circle): :meth:`Region.boundary_scheme`, :meth:`CylinderRegion.boundary_scheme`.
+    On the whole workspace, a K the scheme has (:func:`scheme_parameter`):
+    ``robot.workspace.boundary_scheme(n)`` -- the paper's scheme on a
+    rectangle (``n = K/2`` poses on ``y = H`` then on ``y = H + h``), the ring
+    scheme on a cylinder (``n`` poses on the top circle, then on the bottom
+    one), the corner scheme on a box (``K = n`` = 64, 32 or 16 corners).  On a
+    smaller region or for another K the same rule on the region: on a
+    rectangle or a cylinder ``ceil(K/2)`` poses on the first boundary
+    (``y = ymin``; the top circle) and ``floor(K/2)`` on the second
+    (:meth:`Region.boundary_scheme`, :meth:`CylinderRegion.boundary_scheme`);
+    on a box the corner rule (:meth:`BoxRegion.baseline_poses`).
 
     Returns
     -------
     ndarray, shape (K, n)
-        mm, in visiting order.
+        Internal units (mm, rad), in visiting order.
     """
     ws = workspace_region(robot)
     region = region or ws
-    if K % 2 == 0 and region == ws:
-        return robot.workspace.boundary_scheme(K // 2)
+    n = scheme_parameter(robot.workspace, K)
+    if n is not None and region == ws:
+        return robot.workspace.boundary_scheme(n)
+    if hasattr(region, "baseline_poses"):
+        return region.baseline_poses(K)
     n1 = (K + 1) // 2
     return region.boundary_scheme(n1, K - n1)
 
@@ -103,8 +117,11 @@ def choose_baseline(robot, K: int, cons: Constraints):
     scheme = robot.workspace.scheme_name
     region = cons.region
     cands = []
-    if hasattr(region, "boundary_scheme"):
-        label = f"{scheme} scheme" if region == ws else f"{scheme} rule on the region's boundaries"
+    if hasattr(region, "boundary_scheme") or hasattr(region, "baseline_poses"):
+        if hasattr(region, "baseline_poses") and not (region == ws and scheme_parameter(robot.workspace, K)):
+            label = f"{scheme} rule on the {'workspace' if region == ws else 'region'} ({K} corners)"
+        else:
+            label = f"{scheme} scheme" if region == ws else f"{scheme} rule on the region's boundaries"
         cands.append((label, paper_baseline(robot, K, region)))
     if region != ws:
         cands.append((f"{scheme} scheme on the workspace", paper_baseline(robot, K, ws)))
@@ -189,14 +206,26 @@ class DesignResult:
     certificate: dict | None = None
     approximate: dict | None = None
     tolerances: dict | None = None
+    noise_report: dict | None = None
+    #: the baseline's poses in internal units (mm, rad), shape (K, n), or None (``paper["poses"]`` is in file
+    #: units)
+    baseline_poses: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
         return json_safe(self._dict())
 
+    def _exchange_user(self) -> dict:
+        """The exchange's entry with its poses in file units (as the report's)."""
+        ex = dict(self.exchange)
+        if "poses" in ex:
+            ex["poses"] = _poses_in_units(ex["poses"], self.report.get("pose_units"))
+        return ex
+
     def _dict(self) -> dict:
         rep = dict(self.report)
         pp = self.paper or {}
+        crlb_key = f"crlb_rms_{rep.get('joint_unit', 'deg')}"
         rep.update({
             "K": len(self.poses),
             "method": self.method,
@@ -206,7 +235,7 @@ class DesignResult:
             "baseline_rejected": self.baseline_rejected,
             "paper": self.paper,
             "ratio": {
-                "crlb_rms_design_over_paper": _ratio(self.report["crlb_rms_deg"], pp.get("crlb_rms_deg")),
+                "crlb_rms_design_over_paper": _ratio(self.report[crlb_key], pp.get(crlb_key)),
                 "criterion_design_over_paper": _ratio(self.report["criterion"]["value"],
                                                       pp.get("criterion", {}).get("value")),
                 "kappa_design_over_paper": _ratio(self.report["kappa"], pp.get("kappa")),
@@ -214,14 +243,26 @@ class DesignResult:
             "certificate": self.certificate,
             "approximate": self.approximate,
             "constraints": self.constraints.to_dict(),
-            "noise": None if self.noise is None else {"sigma_scale_mm": self.noise.sigma_scale_mm,
-                                                      "sigma_servo_deg": math.degrees(self.noise.sigma_servo_rad)},
+            "noise": self.noise_report if self.noise_report is not None else (
+                None if self.noise is None else {"sigma_scale_mm": self.noise.sigma_scale_mm,
+                                                 "sigma_servo_deg": math.degrees(self.noise.sigma_servo_rad)}),
             "exchange": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                         for k, v in self.exchange.items() if k != "objective"},
+                         for k, v in self._exchange_user().items() if k != "objective"},
             "continuous": {k: v for k, v in self.continuous.items() if k in ("value", "runs", "time_s", "build_s")},
             "timing_s": self.timing,
         })
         return rep
+
+
+def _poses_in_units(P, pose_units):
+    """Poses (internal units) in the file units ``pose_units`` names per coordinate (deg: from rad)."""
+    from zerocal_sym.model import units
+
+    P = np.array(P, float)
+    for i, u in enumerate(pose_units or ()):
+        if u == "deg":
+            P[..., i] = units.to_user(P[..., i], "rad")
+    return P
 
 
 def _ratio(a, b):
@@ -240,7 +281,7 @@ def _certificate(ad, criterion, value, K, design_value_crlb=None):
         return None
     d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K),
          "measure_efficiency_lower_bound": ad.eff_lb, "n_candidates": ad.n_candidates,
-         "rho_window_mm": list(ad.window), "windows": ad.windows,
+         "rho_window_mm": list(ad.window), "windows": ad.windows, "candidates": ad.info.get("candidates"),
          "model": "order-free pose model (servo variance + sigma_m^2/4 per pose): its optimum bounds every "
                   "ordered K-pose design on the candidates"}
     if criterion == ad.criterion:
@@ -324,7 +365,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         raise DesignError(f"K = {K} is too large for the exact method (at most {MAX_K_EXACT}; the approximate "
                           "method takes any K)")
     noise = NoiseModel.coerce(noise, robot=robot)
-    _noise_terms(noise)
+    _noise_terms(noise, robot)
     cons = cons or make_constraints(robot)
     timing = {}
     t0 = time.perf_counter()
@@ -385,4 +426,6 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     return DesignResult(poses=P, criterion=criterion, report=report, paper=paper, constraints=cons, exchange=ex,
                         continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme,
                         baseline_note=base_note, baseline_rejected=rejected, baseline_label=base_label,
-                        certificate=cert, approximate=approx_info, tolerances=tolerances)
+                        certificate=cert, approximate=approx_info, tolerances=tolerances,
+                        noise_report=dict(noise_dict(robot, noise), description=describe_noise(robot, noise)),
+                        baseline_poses=base)

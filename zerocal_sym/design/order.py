@@ -35,7 +35,7 @@ def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None,
     """
     P = np.atleast_2d(np.asarray(P, float))
     K = len(P)
-    sm2, sx2 = _noise_terms(noise)
+    sm2, sx2 = _noise_terms(noise, robot)
     qs = _qscale(robot)
     wc = _criterion_weights(robot, criterion, tolerances)
     t = pose_terms(robot, P)

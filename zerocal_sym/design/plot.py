@@ -17,19 +17,24 @@ def _labels(result):
     d = result.to_dict()
     ratio = d["ratio"]["crlb_rms_design_over_paper"]
     base = f"{result.baseline}'s scheme" if result.baseline == "paper" else f"{result.baseline} scheme"
-    crlb = result.report["crlb_rms_deg"]
+    u = result.report.get("joint_unit", "deg")
+    crlb = result.report[f"crlb_rms_{u}"]
     fmt = ".3f" if crlb >= 0.01 else ".3g"
     if result.paper is None:
-        return (base, None, f"{result.criterion}-optimal (CRLB {format(crlb, fmt)} deg)",
+        return (base, None, f"{result.criterion}-optimal (CRLB {format(crlb, fmt)} {u})",
                 f"K = {len(result.poses)}, criterion {result.criterion}; no feasible baseline")
-    return (base, f"{base} (CRLB {result.paper['crlb_rms_deg']:.3f} deg)",
-            f"{result.criterion}-optimal (CRLB {format(crlb, fmt)} deg)",
+    pc = result.paper[f"crlb_rms_{u}"]
+    return (base, f"{base} (CRLB {format(pc, '.3f' if pc >= 0.01 else '.3g')} {u})",
+            f"{result.criterion}-optimal (CRLB {format(crlb, fmt)} {u})",
             f"K = {len(result.poses)}, criterion {result.criterion}; CRLB ratio design/{result.baseline} "
             f"{'-' if ratio is None else format(ratio, '.3g')}")
 
 
 def _baseline_poses(result, n):
-    return np.asarray(result.paper["poses"]) if result.paper is not None else np.empty((0, n))
+    if result.paper is None:
+        return np.empty((0, n))
+    P = getattr(result, "baseline_poses", None)
+    return np.asarray(result.paper["poses"] if P is None else P)
 
 
 def _numbered(ax, X, Y, color="tab:blue"):

@@ -92,7 +92,7 @@ class PoseModel:
     """
 
     def __init__(self, robot, X, noise, criterion, weights: Weights | None = None):
-        sm2, sx2 = _noise_terms(noise)
+        sm2, sx2 = _noise_terms(noise, robot)
         self.X = np.atleast_2d(np.asarray(X, float))
         t = pose_terms(robot, self.X)
         self.aq = t["a"] * _qscale(robot)

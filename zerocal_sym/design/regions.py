@@ -343,8 +343,9 @@ def _grid(lo, hi, npts):
     return axes, h
 
 
-def make_reachable(robot, clip=None, margin=0.2, joint_limits_deg=None, grid_points=GRID_POINTS):
-    """The :class:`ReachableRegion` of a robot for a margin and joint limits, clipped.
+def make_reachable(robot, clip=None, margin=0.2, joint_limits=None, grid_points=GRID_POINTS):
+    """The :class:`ReachableRegion` of a robot for a margin and joint limits (internal units, rad or mm,
+    shape (m, 2)), clipped.
 
     Raises
     ------
@@ -357,7 +358,7 @@ def make_reachable(robot, clip=None, margin=0.2, joint_limits_deg=None, grid_poi
 
     n = robot.n
     signs = mode_signs(robot)
-    jl = None if joint_limits_deg is None else np.radians(np.asarray(joint_limits_deg, float))
+    jl = None if joint_limits is None else np.asarray(joint_limits, float)
     if clip is not None:
         clo, chi = clip.bbox() if hasattr(clip, "bbox") else (clip.lo, clip.hi)
     else:

@@ -19,7 +19,7 @@ import numpy as np
 from zerocal_sym.design.constraints import Constraints, _pointwise_ok, make_constraints
 from zerocal_sym.design.criteria import _criterion_terms, _criterion_weights, _noise_terms, _objective_batch
 from zerocal_sym.design.limits import DesignError
-from zerocal_sym.design.terms import _qscale, pose_terms
+from zerocal_sym.design.terms import _qscale, _user_scale, pose_distances, pose_terms
 
 if TYPE_CHECKING:
     from zerocal_sym.design.approx import ApproxDesign
@@ -87,6 +87,7 @@ def place_replicates(robot, cons: Constraints, reps, counts, window=None, score=
     """
     n = robot.n
     sp = max(cons.min_separation_mm, 0.01) * (1 + 1e-6)
+    us = _user_scale(robot)  # the lattice in file units: a degree of an orientation counts as a mm
     P, lab = [np.empty((0, n))], [np.empty(0, int)]
     placed = np.empty((0, n))
     for i, (x, c) in enumerate(zip(np.atleast_2d(reps), counts)):
@@ -94,14 +95,14 @@ def place_replicates(robot, cons: Constraints, reps, counts, window=None, score=
             continue
         m = 3 * c + 10
         while True:
-            Y = x + _lattice(n, sp, m)[:m]
+            Y = x + _lattice(n, sp, m)[:m] / us
             ok = _pointwise_ok(robot, Y, cons)
             if window is not None and np.any(ok):
                 rho = pose_terms(robot, Y[ok])["rho"]
                 okk = (rho >= window[0] - 1e-9) & (rho <= window[1] + 1e-9)
                 ok[np.flatnonzero(ok)] = okk
             if len(placed) and np.any(ok):
-                dist = np.min(np.linalg.norm(Y[ok][:, None, :] - placed[None], axis=2), axis=1)
+                dist = np.min(pose_distances(robot, Y[ok], placed), axis=1)
                 ok[np.flatnonzero(ok)] = dist >= sp * (1 - 1e-9)
             good = Y[ok]
             if len(good) >= c:
@@ -190,7 +191,7 @@ def realize(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None, no
     counts = efficient_rounding(ws, K)
     window = ad.window if cons.travel_mode == "range" else None
     P, lab = place_replicates(robot, cons, reps, counts, window, ad.sensitivity(robot, noise))
-    sm2, sx2 = _noise_terms(noise)
+    sm2, sx2 = _noise_terms(noise, robot)
     wt = _criterion_weights(robot, criterion, tolerances)
     t = pose_terms(robot, P)
     aq, v = _criterion_terms(robot, criterion, t, _qscale(robot), sx2, wt)

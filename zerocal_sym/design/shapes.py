@@ -198,12 +198,176 @@ class CylinderRegion(CentredBox):
                               "ZMIN < ZMAX; order: RW ZMIN ZMAX)")
 
 
+def _to_internal(unit: str) -> str:
+    """The internal unit of a file unit: ``rad`` for ``deg``, ``mm`` for ``mm``."""
+    return "rad" if unit == "deg" else "mm"
+
+
+def corner_scheme(lo, hi, K: int) -> np.ndarray:
+    """K corners of the box ``[lo, hi]`` (shape (n,) each): the corner scheme carried to any K.
+
+    ``K = 2^n``: every corner in binary order (corner k sets coordinate j to its maximum where bit j of k is
+    1); in 6-D, K = 32 or 16: the regular fractions of the workspace's corner scheme
+    (:data:`zerocal_sym.model.workspace.BOX_FRACTIONS`); any other K: the first K corners of the smallest of
+    these with at least K corners (so that every coordinate turns, as far as K allows).
+
+    Returns
+    -------
+    ndarray, shape (K, n)
+    """
+    from zerocal_sym.model.workspace import BOX_FRACTIONS
+
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    n = len(lo)
+    sizes = sorted(BOX_FRACTIONS) if n == 6 else [2 ** n]
+    N = next((k for k in sizes if k >= K), None)
+    if N is None:
+        raise DesignError(f"the corner rule has at most {sizes[-1]} corners in {n}-D, got K = {K}")
+    gens = BOX_FRACTIONS[N] if n == 6 else {}
+    free = [j for j in range(n) if j not in gens]
+    out = []
+    for k in range(K):
+        bits = [0] * n
+        for i, j in enumerate(free):
+            bits[j] = (k >> i) & 1
+        for j, src in gens.items():
+            bits[j] = int(np.bitwise_xor.reduce([bits[i] for i in src]))
+        out.append(np.where(bits, hi, lo))
+    return np.array(out)
+
+
+@dataclass(frozen=True)
+class BoxRegion(CentredBox):
+    """Design region of a box workspace (any dimension; the hexapod's 6-D pose): ``lo <= P <= hi`` per pose
+    coordinate.
+
+    ``lo_box``, ``hi_box`` in internal units (mm, rad); ``names`` the pose coordinates, ``units`` their file
+    units (mm, deg): a user gives and reads the box in those (``--region X_MIN X_MAX ... YAW_MIN YAW_MAX``).
+    """
+
+    lo_box: tuple
+    hi_box: tuple
+    names: tuple
+    units: tuple
+    kind = "box"
+    #: default candidate grid of the exchange: points per coordinate (3^6 = 729 in 6-D)
+    default_grid = (3,)
+
+    @classmethod
+    def workspace(cls, robot):
+        return workspace_region(robot)
+
+    @classmethod
+    def from_user(cls, names, units, values):
+        """The box from ``LO1 HI1 LO2 HI2 ...`` in file units (mm, deg)."""
+        v = np.asarray(values, float)
+        conv = [_to_internal(u) for u in units]
+        from zerocal_sym.model.units import from_user
+
+        lo = tuple(float(from_user(x, c)) for x, c in zip(v[0::2], conv))
+        hi = tuple(float(from_user(x, c)) for x, c in zip(v[1::2], conv))
+        return cls(lo, hi, tuple(names), tuple(units))
+
+    @staticmethod
+    def arg_names_of(names):
+        """The numbers a user gives: ``X_MIN X_MAX Y_MIN ...`` (file units)."""
+        return tuple(f"{nm.upper()}_{b}" for nm in names for b in ("MIN", "MAX"))
+
+    @property
+    def arg_names(self):
+        return self.arg_names_of(self.names)
+
+    @property
+    def n(self):
+        return len(self.lo_box)
+
+    @property
+    def lo(self):
+        """ndarray, shape (n,)"""
+        return np.array(self.lo_box, float)
+
+    @property
+    def hi(self):
+        """ndarray, shape (n,)"""
+        return np.array(self.hi_box, float)
+
+    def grid(self, k: int = 3):
+        """``k^n`` points on a regular grid over the box (every corner among them), shape (k^n, n)."""
+        axes = [np.linspace(a, b, k) for a, b in zip(self.lo_box, self.hi_box)]
+        return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, self.n)
+
+    def reach_grid(self):
+        """Points checked for reachability: the 3^n grid (the corners, the centres of the faces, ...)."""
+        return self.grid(3)
+
+    def design_grid(self, n_target):
+        """Candidates of the approximate design: ``k^n`` grid points, ``k = max(3, round(n_target^(1/n)))``
+        (3 per coordinate in 6-D: 729), and the spacing per coordinate, shape (n,)."""
+        k = max(3, int(round(n_target ** (1.0 / self.n))))
+        return self.grid(k), (self.hi - self.lo) / (k - 1)
+
+    def contains(self, P, tol: float = _FEAS_TOL) -> np.ndarray:
+        P = np.atleast_2d(P)
+        return np.all((P >= self.lo - tol) & (P <= self.hi + tol), axis=1)
+
+    def sample(self, rng, N: int) -> np.ndarray:
+        """N uniform random points in the box, shape (N, n)."""
+        return self.lo + rng.uniform(size=(N, self.n)) * (self.hi - self.lo)
+
+    def baseline_poses(self, K: int) -> np.ndarray:
+        """The corner rule on the box with K poses (:func:`corner_scheme`), shape (K, n)."""
+        return corner_scheme(self.lo, self.hi, K)
+
+    def user_values(self):
+        """``[lo1, hi1, lo2, ...]`` in file units (mm, deg)."""
+        from zerocal_sym.model.units import to_user
+
+        out = []
+        for a, b, u in zip(self.lo_box, self.hi_box, self.units):
+            c = _to_internal(u)
+            out += [float(to_user(a, c)), float(to_user(b, c))]
+        return out
+
+    def describe(self) -> str:
+        v = self.user_values()
+        return ", ".join(f"{nm} in [{v[2 * i]:.6g}, {v[2 * i + 1]:.6g}]{'' if u == 'mm' else ' ' + u}"
+                         for i, (nm, u) in enumerate(zip(self.names, self.units)))
+
+    def as_list(self):
+        return self.user_values()
+
+    def _check(self):
+        v = self.user_values()
+        for i, (nm, u) in enumerate(zip(self.names, self.units)):
+            if not v[2 * i + 1] - v[2 * i] >= 1.0:
+                raise DesignError(f"region {self.describe()} (mm, deg) is empty or thinner than 1 {u} in {nm} "
+                                  f"(need {nm.upper()}_MIN < {nm.upper()}_MAX; order: "
+                                  f"{' '.join(self.arg_names)})")
+
+
 #: workspace kind -> design region class
-REGIONS = {"rectangle": Region, "cylinder": CylinderRegion}
+REGIONS = {"rectangle": Region, "cylinder": CylinderRegion, "box": BoxRegion}
+
+
+def region_arg_names(robot):
+    """The numbers ``--region`` takes for the robot's workspace shape (``XMIN XMAX YMIN YMAX``, ``RW ZMIN ZMAX``,
+    ``X_MIN X_MAX ... YAW_MIN YAW_MAX``)."""
+    cls = REGIONS[robot.workspace.kind]
+    if cls is BoxRegion:
+        return BoxRegion.arg_names_of(robot.mechanism.pose_names)
+    return cls.arg_names
+
+
+def region_units(robot) -> str:
+    """The units of ``--region``'s numbers: ``mm``, or ``mm, deg for orientations``."""
+    from zerocal_sym.model import units
+
+    return "mm" if all(units.pose_unit(robot, nm) == "mm" for nm in robot.mechanism.pose_names) else \
+        "mm; deg for orientations"
 
 
 def workspace_region(robot):
-    """The robot's workspace as a design region (:class:`Region` or :class:`CylinderRegion`)."""
+    """The robot's workspace as a design region (:class:`Region`, :class:`CylinderRegion`, :class:`BoxRegion`)."""
     ws = robot.workspace
     if ws.kind == "rectangle":
         lo, hi = ws.bounds()
@@ -211,13 +375,20 @@ def workspace_region(robot):
     if ws.kind == "cylinder":
         lo, hi = ws.bounds()
         return CylinderRegion(float(ws.rw), float(lo[2]), float(hi[2]))
+    if ws.kind == "box":
+        from zerocal_sym.model import units
+
+        lo, hi = ws.bounds()
+        names = tuple(robot.mechanism.pose_names)
+        return BoxRegion(tuple(float(v) for v in lo), tuple(float(v) for v in hi), names,
+                         tuple(units.pose_unit(robot, nm) for nm in names))
     raise DesignError(f"no design region for a {ws.kind} workspace (known: {', '.join(REGIONS)})")
 
 
 REGION_KINDS = ("reachable", "polygon")
 
 
-def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_limits_deg=None):
+def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_limits=None):
     """A validated design region.
 
     Parameters
@@ -238,8 +409,9 @@ def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_
         With ``"reachable"``: a box ``XMIN XMAX YMIN YMAX [ZMIN ZMAX]`` (2n
         numbers, ``-inf``/``inf`` for open sides) or, in 3-D, a cylinder
         ``RW ZMIN ZMAX`` (3 numbers).
-    singularity_margin, joint_limits_deg
-        For the reachable set (default the robot's margin, no limits).
+    singularity_margin, joint_limits
+        For the reachable set (default the robot's margin, no limits); the limits in internal units (rad, mm),
+        shape (m, 2).
 
     Raises
     ------
@@ -253,10 +425,14 @@ def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_
         margin = robot.singularity_margin if singularity_margin is None else singularity_margin
         try:
             if kind == "reachable":
+                if region_units(robot) != "mm":
+                    raise DesignError(f"--region reachable is found on a grid of positions; robot {robot.name!r} "
+                                      "has orientation coordinates: give the box's numbers "
+                                      f"{' '.join(region_arg_names(robot))} ({region_units(robot)})")
                 if len(vals) > 1:
                     raise DesignError("--region reachable takes no numbers (give the clip with --bounds)")
                 clip = _make_bounds(robot, bounds)
-                return rg.make_reachable(robot, clip, margin, joint_limits_deg)
+                return rg.make_reachable(robot, clip, margin, joint_limits)
             if kind == "polygon":
                 if robot.n != 2:
                     raise DesignError(f"a polygon region is planar; robot {robot.name!r} has {robot.n} pose "
@@ -266,14 +442,14 @@ def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_
                 nums = [_finite(f"polygon coordinate {i + 1}", v) for i, v in enumerate(vals[1:])]
                 if len(nums) % 2:
                     raise DesignError(f"a polygon needs pairs X Y, got {len(nums)} numbers")
-                return rg.make_reachable(robot, rg.Polygon.make(nums), margin, joint_limits_deg)
+                return rg.make_reachable(robot, rg.Polygon.make(nums), margin, joint_limits)
         except rg.RegionError as exc:
             raise DesignError(str(exc)) from None
         raise DesignError(f"unknown region {vals[0]!r} (known: reachable, polygon, or numbers: "
-                          f"{' '.join(REGIONS[robot.workspace.kind].arg_names)})")
+                          f"{' '.join(region_arg_names(robot))})")
     if isinstance(region, rg.Polygon):
         return rg.make_reachable(robot, region, robot.singularity_margin if singularity_margin is None
-                                 else singularity_margin, joint_limits_deg)
+                                 else singularity_margin, joint_limits)
     if isinstance(region, rg.ReachableRegion):
         return region
     if bounds is not None:
@@ -289,11 +465,16 @@ def make_region(robot, region=None, bounds=None, singularity_margin=None, joint_
             raise DesignError(f"a {region.kind} region does not fit robot {robot.name!r} (its workspace is a {kind})")
     else:
         vals = list(region)
-        names = cls.arg_names
+        names = region_arg_names(robot)
         if len(vals) != len(names):
-            raise DesignError(f"region needs {len(names)} numbers {' '.join(names)} (mm) for a {kind} workspace, "
-                              f"got {len(vals)}")
-        region = cls(*[_finite(nm, v) for nm, v in zip(names, vals)])
+            raise DesignError(f"region needs {len(names)} numbers {' '.join(names)} ({region_units(robot)}) for a "
+                              f"{kind} workspace, got {len(vals)}")
+        nums = [_finite(nm, v) for nm, v in zip(names, vals)]
+        if cls is BoxRegion:
+            ws = workspace_region(robot)
+            region = BoxRegion.from_user(ws.names, ws.units, nums)
+        else:
+            region = cls(*nums)
     region._check()
     return region
 

@@ -15,6 +15,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from zerocal_sym.model import units
+
 
 def _call_ik(robot, P):
     """Inverse kinematics and reach ratios without checks, shapes (K, m) each."""
@@ -32,6 +34,100 @@ def _reachable(ratio, theta, tol: float = 0.0) -> np.ndarray:
 def design_params(robot) -> tuple:
     """Names of the design parameters: the zero offsets and the MAEMM (the paper's set), p = m + n."""
     return robot.errors.resolve("paper")
+
+
+# --------------------------------------------------------------------------- units of the reports
+def offset_unit(robot) -> str:
+    """The zero offsets' file unit (``deg`` for revolute joints, ``mm`` for prismatic ones): the unit of the
+    ``crlb`` and ``mse`` criteria, of the CRLB and the bias of the offsets, of the joints and their limits."""
+    return units.joint_unit(robot)
+
+
+def okey(robot, stem: str) -> str:
+    """``<stem>_deg`` or ``<stem>_mm`` after the joints' kind (``crlb_zero_offsets_deg``, ``joints_mm``)."""
+    return units.joint_key(robot, stem)
+
+
+def offsets_to_user(robot, values):
+    """Zero offsets (or joint values), internal units -> file units (deg or mm), shape kept."""
+    return units.joints_to_user(robot, values)
+
+
+def offsets_from_user(robot, values):
+    """Zero offsets (or joint values), file units (deg or mm) -> internal units (rad or mm), shape kept."""
+    return units.joints_from_user(robot, values)
+
+
+def noise_dict(robot, noise) -> dict:
+    """The noise of a report: ``sigma_scale_mm`` and the joint term in the joints' file unit
+    (``sigma_servo_deg`` for revolute joints, ``sigma_joint_mm`` for prismatic ones)."""
+    j = float(offsets_to_user(robot, noise.sigma_joint))
+    name = "sigma_servo_deg" if robot.mechanism.joint_kind == "revolute" else okey(robot, "sigma_joint")
+    return {"sigma_scale_mm": float(noise.sigma_scale_mm), name: j}
+
+
+def joint_sigma(robot, noise_d: dict) -> float:
+    """The joint term of a :func:`noise_dict` (file units)."""
+    return next(v for k, v in noise_d.items() if k.startswith("sigma_") and k != "sigma_scale_mm")
+
+
+def noise_source(robot, noise) -> str:
+    """Where a noise model comes from: ``paper, Eqs. 34-35``, ``robot file [noise]``, ``mechanism X's default``,
+    or ``""`` (neither: a scaled or partial model)."""
+    from zerocal_sym.model.noise import NoiseModel
+
+    if noise == NoiseModel.paper():
+        return "paper, Eqs. 34-35"
+    if noise == robot.noise:
+        return ("robot file [noise]" if dict(getattr(robot, "noise_values", ()) or {})
+                else f"mechanism {robot.mechanism_name}'s default")
+    return ""
+
+
+def describe_noise(robot, noise) -> str:
+    """What a noise model is, for a report: the paper's Eqs. 34-35 when it is theirs, else its two terms and
+    where they come from (the robot file's ``[noise]``, the mechanism's default)."""
+    from zerocal_sym.model.noise import NoiseModel
+
+    if noise == NoiseModel.paper():
+        return "paper (Eq. 34 scale + Eq. 35 servo)"
+    j = float(offsets_to_user(robot, noise.sigma_joint))
+    terms = (f"scale {noise.sigma_scale_mm:g} mm per change + joint {j:g} {offset_unit(robot)} per joint per "
+             "pose")
+    src = noise_source(robot, noise)
+    return f"the robot's ({src}): {terms}" if src else terms
+
+
+def pose_units(robot) -> list:
+    """The file unit of each pose coordinate (``mm``, ``deg``), shape (n,)."""
+    return [units.pose_unit(robot, name) for name in robot.mechanism.pose_names]
+
+
+def poses_to_user(robot, P):
+    """Poses in file units (orientations in degrees), shape kept."""
+    return units.pose_to_user(robot, P)
+
+
+def poses_from_user(robot, P):
+    """Poses from file units (orientations in degrees) to internal units, shape kept."""
+    return units.pose_from_user(robot, P)
+
+
+def _user_scale(robot) -> np.ndarray:
+    """File units per internal unit of each pose coordinate (1 for mm, 180/pi for an angle), shape (n,)."""
+    return units.pose_to_user(robot, np.ones(robot.n))
+
+
+def pose_distances(robot, P, Q=None):
+    """Distances between poses in file units (mm; a degree of an orientation counts as a mm), shape (K, L).
+
+    The minimum separation of a design is measured so: two poses of a platform that turns are apart when
+    their positions differ by the separation in mm or their orientations by as many degrees.  For a pose of
+    positions alone it is the Euclidean distance in mm.
+    """
+    A = poses_to_user(robot, np.atleast_2d(P))
+    B = A if Q is None else poses_to_user(robot, np.atleast_2d(Q))
+    return np.linalg.norm(A[:, None, :] - B[None], axis=2)
 
 
 def omitted_params(robot) -> tuple:
@@ -144,17 +240,21 @@ def position_grid(robot) -> np.ndarray:
 def position_jacobians(robot):
     """Error Jacobians ``dP = J dq`` (q = lever-arm arcs of the zero offsets, mm) over :func:`position_grid`.
 
+    Only the position coordinates (those in mm) are kept: a platform's orientation error is not a position
+    error (for a pose of positions alone, every coordinate).
+
     Returns
     -------
     grid : ndarray, shape (G, n)
-    J : ndarray, shape (G, n, m)
+    J : ndarray, shape (G, n_pos, m)
     """
     from zerocal_sym.model import kinematics as kin
 
     key = robot.sha256
     if key not in _POSITION_CACHE:
         grid = position_grid(robot)
-        _POSITION_CACHE[key] = (grid, kin.error_jacobian(robot, grid))
+        pos = [i for i, u in enumerate(pose_units(robot)) if u == "mm"]
+        _POSITION_CACHE[key] = (grid, kin.error_jacobian(robot, grid)[:, pos, :])
     return _POSITION_CACHE[key]
 
 

@@ -7,21 +7,28 @@ import time
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model import units
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import DesignError
+from zerocal_sym.design.terms import offsets_to_user, okey
 
 #: default true zero offsets (deg), the first m of them: joint 1, 2, 3 (planar: Table 2 group 1)
 DEFAULT_OFFSETS_DEG = (2.0, -1.0, 0.5)
-#: default true MAEMM (mm), the first n of them: x, y, z (planar: Table 2 group 1)
-DEFAULT_MAEMM_MM = (1.0, 0.5, -0.5)
+#: default true zero offsets of prismatic joints (mm), the first m of them
+DEFAULT_OFFSETS_MM = (0.3, -0.2, 0.1, 0.25, -0.15, 0.05)
+#: default true MAEMM (mm), the first n of them: x, y, z (planar: Table 2 group 1), then further measuring errors
+DEFAULT_MAEMM_MM = (1.0, 0.5, -0.5, 0.05, 0.0, -0.05)
 
 
 def default_true_errors(robot) -> np.ndarray:
-    """Default truth of :func:`verify_design`: zero offsets and MAEMM only, no geometric errors.
+    """Default truth of :func:`verify_design`: zero offsets and the identified measuring errors, nothing else.
 
-    The zero offsets (joint order) are ``(2, -1, 0.5)[:m]`` deg and the MAEMM
-    (pose-coordinate order) ``(1, 0.5, -0.5)[:n]`` mm, set by name -- for the
-    planar robot exactly Table 2 group 1 without its geometric errors.
+    The zero offsets (joint order) are ``(2, -1, 0.5)[:m]`` deg for revolute joints,
+    ``(0.3, -0.2, 0.1, 0.25, -0.15, 0.05)[:m]`` mm for prismatic ones; the
+    measuring errors of the identified set (:func:`zerocal_sym.design.terms.design_params`, in their order)
+    ``(1, 0.5, -0.5, 0.05, 0, -0.05)[:u]`` mm, set by name -- for the planar robot exactly Table 2 group 1
+    without its geometric errors.  A measuring error outside the identified set (the linear Delta's ``rMz``)
+    stays zero: the estimator holds it there.
 
     Returns
     -------
@@ -31,15 +38,19 @@ def default_true_errors(robot) -> np.ndarray:
     Raises
     ------
     DesignError
-        A mechanism with more than three joints or pose coordinates (give
-        ``err_true``).
+        A mechanism with more joints or identified measuring errors than these lists (give ``err_true``).
     """
+    from zerocal_sym.design.terms import design_params
+
     errors = robot.errors
-    z, mm = errors.zero_offsets, errors.measuring
-    if len(z) > len(DEFAULT_OFFSETS_DEG) or len(mm) > len(DEFAULT_MAEMM_MM):
+    z = errors.zero_offsets
+    keep = set(design_params(robot))
+    mm = tuple(n for n in errors.measuring if n in keep)
+    offs = DEFAULT_OFFSETS_DEG if errors.offset_unit == "rad" else DEFAULT_OFFSETS_MM
+    if len(z) > len(offs) or len(mm) > len(DEFAULT_MAEMM_MM):
         raise DesignError(f"no default true errors for mechanism {robot.mechanism_name!r} "
                           f"({len(z)} zero offsets, {len(mm)} MAEMM components): give err_true")
-    values = {name: math.radians(v) for name, v in zip(z, DEFAULT_OFFSETS_DEG)}
+    values = {name: errors.from_user_value(name, v) for name, v in zip(z, offs)}
     values.update({name: v for name, v in zip(mm, DEFAULT_MAEMM_MM)})
     return errors.vector(values)
 
@@ -63,7 +74,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
         Poses in visiting order, mm (commanded by nominal inverse kinematics).
     n_trials : int
     noise : NoiseModel, optional
-        Default the paper's.
+        Default the robot's (:attr:`Robot.noise`).
     err_true : ndarray, shape (q,) or dict name -> value, optional
         True source errors (rad, mm; a dict by name as for
         :class:`~zerocal_sym.model.noise.VirtualPlant`).  Default
@@ -79,6 +90,7 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     Returns
     -------
     dict
+        Keys of offsets in their file unit (``_deg``; ``_mm`` for prismatic joints, ``unit`` says which):
         ``offset_names`` (m,), ``rms_error_deg`` (m,) per offset and
         ``rms_error_rms_deg`` (over all), ``mean_error_deg`` (m,),
         ``crlb_at_truth_deg`` (m,) and its RMS, ``true_errors``
@@ -108,16 +120,19 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     ok = mc["success"]
     failed = int(np.sum(~ok))
     m = len(offsets)
-    E = np.degrees(mc["estimate"][ok][:, [mc["params"].index(n) for n in offsets]] - true_off).reshape(-1, m)
-    crlb = fisher.crlb_zero_offsets_deg(robot, theta, "paper", noise, err0=err)
+    E = offsets_to_user(robot, mc["estimate"][ok][:, [mc["params"].index(n) for n in offsets]]
+                        - true_off).reshape(-1, m)
+    crlb = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise, err0=err)
+    k = lambda stem: okey(robot, stem)  # noqa: E731
     return {"n_trials": int(n_trials), "n_failed": failed, "offset_names": list(offsets),
-            "rms_error_deg": np.sqrt(np.mean(E ** 2, axis=0)).tolist() if len(E) else [math.nan] * m,
-            "rms_error_rms_deg": float(np.sqrt(np.mean(E ** 2))) if len(E) else math.nan,
-            "mean_error_deg": E.mean(axis=0).tolist() if len(E) else [math.nan] * m,
-            "crlb_at_truth_deg": crlb.tolist(), "crlb_at_truth_rms_deg": float(np.sqrt(np.mean(crlb ** 2))),
+            "unit": units.joint_unit(robot),
+            k("rms_error"): np.sqrt(np.mean(E ** 2, axis=0)).tolist() if len(E) else [math.nan] * m,
+            k("rms_error_rms"): float(np.sqrt(np.mean(E ** 2))) if len(E) else math.nan,
+            k("mean_error"): E.mean(axis=0).tolist() if len(E) else [math.nan] * m,
+            k("crlb_at_truth"): crlb.tolist(), k("crlb_at_truth_rms"): float(np.sqrt(np.mean(crlb ** 2))),
             "true_errors": {"by_name": errors.to_dict(err, user=True),
                             "units": {e.name: e.user_unit for e in errors},
-                            "zero_offsets_deg": np.degrees(true_off).tolist(),
+                            k("zero_offsets"): offsets_to_user(robot, true_off).tolist(),
                             "maemm_mm": errors.take(err, errors.measuring).tolist(),
                             "geometric": errors.to_dict(err, errors.geometry, user=True)},
             "time_s": time.perf_counter() - t0}
