@@ -34,8 +34,8 @@ def _variants(K: int, theta, readings):
 
 
 #: the readings refitted exactly when looking for one bad reading: those that would pass the check if the
-#: refit lowered chi² SCREEN_FACTOR times as much as the model linearised at the start says, and at least the
-#: SCREEN_KEEP that lower it most
+#: refit lowered chi² SCREEN_FACTOR times as much as the model linearised at the start says, and the
+#: SCREEN_KEEP with the lowest linearised chi² without them
 SCREEN_FACTOR = 2.0
 SCREEN_KEEP = 8
 

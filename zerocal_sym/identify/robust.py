@@ -39,8 +39,8 @@ import numpy as np
 
 #: default loss scale (standard deviations)
 DEFAULT_SCALE = {"huber": 1.345, "soft_l1": 1.0}
-#: the exact refits without one reading among which the best deletion start is taken: the readings whose
-#: linearised removal lowers chi² most
+#: the exact refits without one reading among which the best deletion start is taken: the readings with the
+#: lowest chi² without them in the linearised model
 DELETION_CANDIDATES = 8
 
 
@@ -215,7 +215,7 @@ def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delt
     args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
     cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
     if K - 2 > len(names):
-        # the readings whose linearised removal lowers chi² most, refitted exactly
+        # the readings with the lowest chi² without them in the linearised model, refitted exactly
         drop = without_each(_Round(*args, pw), [z_l2], select=lambda c, c0, d: lowest(c, DELETION_CANDIDATES))
         chi2 = np.where(drop["refitted"], drop["chi2"], np.inf)
         if np.any(np.isfinite(chi2)):
