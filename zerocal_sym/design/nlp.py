@@ -78,10 +78,10 @@ LARGE_TERMS_NODES = 20000
 
 def nlp_form(robot) -> str:
     """``"exact"`` (exact Hessian of the Lagrangian) or ``"large"`` for a mechanism whose per-pose terms exceed
-    :data:`LARGE_TERMS_NODES` nodes: a limited-memory (L-BFGS) Hessian.  For the hexapod at K = 16 the exact
-    Hessian took 291 s to build and 69 s to solve from the 16-corner fraction, L-BFGS about 30 s and 10 s (and
-    reached a lower CRLB, 0.0369 against 0.0376 mm); the terms as one mapped MX call built in 20 s but its
-    constraint Jacobian took 370 s over the solve (docs/design.md)."""
+    :data:`LARGE_TERMS_NODES` nodes: a limited-memory (L-BFGS) Hessian.  For the hexapod at K = 16, from the
+    16-corner fraction, the exact Hessian took 229 s to build and 62 s to solve, L-BFGS 58 s and 10 s, and
+    reached a lower CRLB (0.03693 against 0.03756 mm): ``python benchmarks/bench_design_hexapod.py --parts
+    form`` (docs/design.md)."""
     return "large" if _pose_terms_fn(robot.mechanism_name).n_nodes() > LARGE_TERMS_NODES else "exact"
 
 
