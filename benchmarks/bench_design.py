@@ -42,8 +42,10 @@ def main():
     ap.add_argument("--K", type=int, nargs="+", default=[6, 20])
     ap.add_argument("--criteria", nargs="+", default=["crlb", "cond"])
     ap.add_argument("--starts", type=int, default=8)
-    ap.add_argument("--only-issue13", action="store_true", help="only the issue-13 cases")
-    ap.add_argument("--no-issue13", action="store_true", help="skip the issue-13 cases")
+    ap.add_argument("--only-extras", "--only-issue13", dest="only_issue13", action="store_true",
+                    help="only the extra cases (reachable set, approximate designs, fewest poses)")
+    ap.add_argument("--no-extras", "--no-issue13", dest="no_issue13", action="store_true",
+                    help="skip the extra cases")
     a = ap.parse_args()
     if not a.only_issue13:
         table(a)

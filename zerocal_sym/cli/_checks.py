@@ -41,7 +41,8 @@ MAEMM_PRIOR_LIMIT_MM = 1000.0
 
 #: design options that belong to --optimize (dest names)
 DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
-                        "joint_limits", "min_separation", "noise", "starts", "workers", "scheduler",
+                        "joint_limits", "joint_limits_deg", "joint_limits_mm", "min_separation", "noise", "starts",
+                        "workers", "scheduler",
                         "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
 #: design --target-crlb X: what it takes besides the region and constraint options (it chooses K, crlb)
 DESIGN_TARGET_NOT = ("K", "criterion", "seed", "verify", "plot", "starts", "workers", "scheduler", "method",
@@ -259,7 +260,7 @@ def _compare(args) -> None:
 
 
 def _design(args) -> None:
-    if getattr(args, "target_crlb", None) is not None:  # issue 13: the fewest poses for a CRLB
+    if any(getattr(args, d, None) is not None for d in ("target_crlb", "target_crlb_deg", "target_crlb_mm")):
         bad = _given(args, *DESIGN_TARGET_NOT, *DESIGN_SCHEME_ONLY) + (["optimize"] if args.optimize else [])
         if bad:
             raise ZerocalError(f"{_opts(bad)}: not with --target-crlb (it chooses K for the crlb criterion; the "

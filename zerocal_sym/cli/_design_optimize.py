@@ -9,25 +9,32 @@ estimator (:func:`zerocal_sym.design.verify_design`) for both designs;
 everything succeeded.
 
 Any mechanism: the design region is the robot's workspace shape (a rectangle
-``XMIN XMAX YMIN YMAX`` or a cylinder ``RW ZMIN ZMAX``), the baseline the
-workspace's boundary scheme with the same K (the paper's scheme, the ring
-scheme), joint limits one ``LO HI`` pair per joint; K defaults to 2n of the
-scheme's default n (6 for the paper's robot, 12 for the Delta).
+``XMIN XMAX YMIN YMAX``, a cylinder ``RW ZMIN ZMAX``, a box ``X_MIN X_MAX ...
+YAW_MIN YAW_MAX`` in mm and deg), the baseline the workspace's boundary scheme
+with the same K (the paper's scheme, the ring scheme, the corner scheme),
+joint limits one ``LO HI`` pair per joint in the joints' unit (deg for
+revolute, mm for prismatic joints); K defaults to the K of the scheme's
+default n (6 for the paper's robot, 12 for a Delta, 64 for the hexapod).
+Every joint quantity is printed and keyed in the joints' unit
+(``crlb_zero_offsets_deg`` or ``crlb_zero_offsets_mm``, ...); the options
+that carry one (``--joint-limits``, ``--target-crlb``) take it, and may be
+spelt with it (``--joint-limits-deg``, ``--target-crlb-mm``, ...:
+:func:`resolve_unit_options`).
 
-Issue 13: ``--region reachable [--bounds ...]`` and ``--region polygon X1 Y1
+Also: ``--region reachable [--bounds ...]`` and ``--region polygon X1 Y1
 ...`` (the reachable non-singular set, clipped); ``--method
 auto|exact|approx`` (the approximate design with its certificate beyond
 K = 24); ``--criterion position|mse``; ``--tolerance NAME=VALUE``,
 ``--tolerance-file``, ``--tolerance-scale`` (the omitted errors' tolerances:
 bias and ``mse``); ``zerocal design --target-crlb X`` -- the fewest poses
-whose design reaches an RMS zero-offset CRLB of X degrees, with the
-certified lower bound (JSON keys ``K`` and ``K_lower_bound``).
+whose design reaches an RMS zero-offset CRLB of X (the joints' unit), with
+the certified lower bound (JSON keys ``K`` and ``K_lower_bound``).
 """
 from __future__ import annotations
 
 
 def add_arguments(p):
-    """The options of issue 13 (called by :mod:`zerocal_sym.cli.cmd_design`)."""
+    """The options of the reachable set, the approximate design, the bias and --target-crlb (called by :mod:`zerocal_sym.cli.cmd_design`)."""
     p.add_argument("--bounds", nargs="+", metavar="MM", default=None,
                    help="clip of --region reachable: XMIN XMAX YMIN YMAX [ZMIN ZMAX] ('open' for an open side), "
                         "or RW ZMIN ZMAX (a cylinder on the z axis, 3-D)")

@@ -67,7 +67,7 @@ def add_arguments(p):
     p.add_argument("--plot", metavar="PNG", default=None, type=OutputFile(), help="plot the poses in the workspace")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="also write the JSON (what --json prints) here")
-    # --optimize constraints and settings (issue 5; defaults in zerocal_sym.design)
+    # --optimize constraints and settings (defaults in zerocal_sym.design)
     p.add_argument("--l0", type=float, default=350.0, metavar="MM",
                    help="scale range l0 in mm (--optimize; default 350, the paper's)")
     p.add_argument("--travel-mode", choices=["range", "consecutive"], default="range",
@@ -92,7 +92,7 @@ def add_arguments(p):
     p.add_argument("--starts", type=int, default=8, help="random Ipopt starts and exchange starts (--optimize)")
     from zerocal_sym.cli import _design_optimize
 
-    _design_optimize.add_arguments(p)  # issue 13: --bounds, --method, --tolerance..., --target-crlb
+    _design_optimize.add_arguments(p)  # --bounds, --method, --tolerance..., --target-crlb
 
 
 def run(args):

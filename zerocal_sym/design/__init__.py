@@ -1,17 +1,20 @@
-"""Measurement-pose design (issue 5): the K measurement poses chosen by constrained
+"""Measurement-pose design: the K measurement poses chosen by constrained
 optimisation for a criterion, with the workspace's boundary scheme at the same K as
-the baseline (the paper's scheme on a rectangle, the ring scheme on a cylinder).
+the baseline (the paper's scheme on a rectangle, the ring scheme on a cylinder, the
+corner scheme on a box).
 
-Generic over the mechanism (issue 10): poses (K, n), joints (K, m), the p = m + n
-parameters of the paper's Eq. (28); the design region is the workspace's shape.
+Generic over the mechanism: poses (K, n), joints (K, m), the p parameters of the
+mechanism's identified set (the paper's Eq. (28) for its robot); the design region is
+the workspace's shape; joint quantities in the joints' unit (deg for revolute joints,
+mm for prismatic ones: :func:`zerocal_sym.design.terms.okey`).
 
 Modules, each importing only from those before it: ``terms`` (per-pose terms
 of the design model), ``limits`` (bounds on K, defaults, :class:`DesignError`),
-``regions`` (the reachable set, clipped: issue 13; imported lazily by
+``regions`` (the reachable set, clipped; imported lazily by
 ``shapes`` and ``constraints``), ``shapes`` (regions of the workspace's shape, any region
 validated), ``constraints`` (and the feasibility checks), ``criteria``, ``order``
 (visiting order), ``exchange`` (discrete exchange), ``nlp`` (continuous
-design, Ipopt), the approximate designs of issue 13 -- ``posemodel`` (the
+design, Ipopt), the approximate designs -- ``posemodel`` (the
 order-free pose model, criteria), ``measure`` (the optimal measure and its
 certificate), ``rounding`` (K poses from a measure), ``fewest`` (fewest
 poses for a target CRLB; imports ``approx`` lazily), ``approx`` (the

@@ -1,4 +1,4 @@
-"""Approximate (continuous) designs with an optimality certificate (issue 13).
+"""Approximate (continuous) designs with an optimality certificate.
 
 An *approximate design* is a probability measure ``xi`` on a finite set of
 candidate poses: weight ``w_x`` on pose ``x``.  K poses realise ``K w_x``

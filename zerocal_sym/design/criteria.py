@@ -2,18 +2,20 @@
 
 Model
 -----
-Parameters: the paper's set ``p = (dtheta_1 .. dtheta_m, drM_1 .. drM_n)``
-(:func:`zerocal_sym.design.terms.design_params`; p = m + n, four for the
-planar robot, six for the Delta), linearised at zero source errors.  Per pose
+Parameters: the mechanism's identified set, the m zero offsets and its
+measuring errors (:func:`zerocal_sym.design.terms.design_params`; four for the
+planar robot, six for the rotary Delta, five for the linear Delta, twelve for
+the hexapod), linearised at zero source errors.  Per pose
 k, ``a_k = d rho_k / d p`` (exact, AD of the generated distance model) and
-``v_k = sigma_xi^2 |d rho_k / d theta|^2`` (servo error).  The K-1 measured
+``v_k = sigma_xi^2 |d rho_k / d theta|^2`` (the joint error, in the joints' unit).  The K-1 measured
 changes have sensitivity ``A = D a`` and covariance
 ``C = sigma_m^2 I + D diag(v) D^T`` (``D`` first differences, see
 :mod:`zerocal_sym.identify.fisher`); ``F = A^T C^-1 A``.
 
 Scaling ("q-units"): the offsets are expressed as arc lengths
 ``q = (L_1 dtheta_1, ..., L_m dtheta_m, drM)`` in mm (lever arms from
-``robot.error_scale``), the units of the paper's identification matrix G
+``robot.error_scale``; a prismatic joint's offset is a length, its scale 1), the units of the paper's
+identification matrix G
 (whose rows are exactly the rows of ``A`` in these units).  ``F_q = T F T``
 with ``T = diag(1/L_1, ..., 1/L_m, 1, ..., 1)``, in 1/mm^2.
 
@@ -31,7 +33,7 @@ Criteria (all minimised internally as a log)
 ``E``
     ``lambda_min(F_q)`` (1/mm^2, maximised).
 ``crlb``
-    ``sqrt(trace([F^-1]_offsets) / m)`` in degrees (minimised): the RMS
+    ``sqrt(trace([F^-1]_offsets) / m)`` in the offsets' file unit, deg or mm (minimised): the RMS
     Cramér-Rao bound of the m zero offsets under the full noise model,
     MAEMM as nuisance parameters.
 ``position``
@@ -41,7 +43,7 @@ Criteria (all minimised internally as a log)
     ``kin.error_jacobian``, ``dP = J dq``); the worst grid point is reported
     beside it (:func:`evaluate`).
 ``mse``
-    ``sqrt(mean_i (CRLB_i^2 + E[b_i^2]))`` in degrees (minimised): the RMS
+    ``sqrt(mean_i (CRLB_i^2 + E[b_i^2]))`` in the offsets' file unit (minimised): the RMS
     error of the m zero offsets including the first-order bias ``b`` from the
     source errors the model leaves out, each uniform within its tolerance
     (:mod:`zerocal_sym.identify.bias`; ``E[b_i^2] = sum_j S_ij^2 t_j^2 / 3``);

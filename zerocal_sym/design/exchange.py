@@ -106,5 +106,6 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
             best_idx, best_o = idx.copy(), cur
     if not np.isfinite(best_o):
         raise DesignError("every exchange start is rank-deficient: the region cannot identify the parameters")
-    return {"poses": cand[best_idx], "objective": float(best_o), "value": _user_value(criterion, best_o, robot.errors.offset_unit),
+    return {"poses": cand[best_idx], "objective": float(best_o),
+            "value": _user_value(criterion, best_o, robot.errors.offset_unit),
             "starts": starts, "n_candidates": int(N), "grid": list(grid), "time_s": time.perf_counter() - t0}

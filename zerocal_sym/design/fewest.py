@@ -1,4 +1,4 @@
-"""The fewest poses whose design reaches a target zero-offset CRLB, with a certified lower bound (issue 13).
+"""The fewest poses whose design reaches a target zero-offset CRLB, with a certified lower bound.
 
 :func:`fewest_poses`: the crlb measure
 (:func:`zerocal_sym.design.approx.approximate_design`) bounds K from below;

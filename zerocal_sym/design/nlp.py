@@ -78,10 +78,10 @@ LARGE_TERMS_NODES = 20000
 
 def nlp_form(robot) -> str:
     """``"exact"`` (exact Hessian of the Lagrangian) or ``"large"`` for a mechanism whose per-pose terms exceed
-    :data:`LARGE_TERMS_NODES` nodes: a limited-memory (L-BFGS) Hessian.  For the hexapod at K = 16 the exact
-    Hessian took 291 s to build and 69 s to solve from the 16-corner fraction, L-BFGS about 30 s and 10 s (and
-    reached a lower CRLB, 0.0369 against 0.0376 mm); the terms as one mapped MX call built in 20 s but its
-    constraint Jacobian took 370 s over the solve (docs/design.md)."""
+    :data:`LARGE_TERMS_NODES` nodes: a limited-memory (L-BFGS) Hessian.  For the hexapod at K = 16, from the
+    16-corner fraction, the exact Hessian took 229 s to build and 62 s to solve, L-BFGS 58 s and 10 s, and
+    reached a lower CRLB (0.03693 against 0.03756 mm): ``python benchmarks/bench_design_hexapod.py --parts
+    form`` (docs/design.md)."""
     return "large" if _pose_terms_fn(robot.mechanism_name).n_nodes() > LARGE_TERMS_NODES else "exact"
 
 
@@ -363,7 +363,7 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
     criterion : {"cond", "D", "A", "E", "crlb"}
     cons : Constraints, optional
     noise : NoiseModel, optional
-        Default: the paper's (scale and servo errors).
+        Default: the robot's (``Robot.noise``: scale and joint errors).
     seed : int
         Seed of the random starts.
     n_starts : int
@@ -393,7 +393,8 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
     if not all_starts:
         raise DesignError("could not find a feasible random start: the constraints leave (almost) no room")
     ref = next((P for _, P in all_starts if np.isfinite(_objective_batch(
-        "D", *_terms_batch(robot, P, noise), _noise_terms(noise, robot)[0], _crlb_weights(robot))[0])), all_starts[0][1])
+        "D", *_terms_batch(robot, P, noise), _noise_terms(noise, robot)[0], _crlb_weights(robot))[0])),
+               all_starts[0][1])
     fscale, mscale = _scales(robot, ref, noise)
     nlp = _NLP(robot, K, criterion, cons, noise, fscale, mscale, max_iter, tolerances=tolerances)
     build_s = time.perf_counter() - t0
@@ -403,12 +404,14 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         P, status, iters = nlp.solve(P0)
         viol = check_design(robot, P, cons)
         o = _objective(robot, criterion, P, noise, tolerances)
-        runs.append({"start": label, "value": _user_value(criterion, o, robot.errors.offset_unit), "status": status, "iterations": iters,
+        runs.append({"start": label, "value": _user_value(criterion, o, robot.errors.offset_unit), "status": status,
+                     "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
         if not viol and np.isfinite(o) and (best is None or o < best[1]):
             best = (P, o)
     if best is None:
         raise DesignError("no Ipopt start ended at a feasible design; statuses: "
                           + ", ".join(sorted({r["status"] for r in runs})))
-    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1], robot.errors.offset_unit), "runs": runs,
+    return {"poses": best[0], "objective": best[1], "value": _user_value(criterion, best[1], robot.errors.offset_unit),
+            "runs": runs,
             "time_s": time.perf_counter() - t0, "build_s": build_s, "nlp": nlp}

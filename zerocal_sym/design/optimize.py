@@ -1,4 +1,4 @@
-"""Measurement-pose design as a constrained optimisation (issue 5).
+"""Measurement-pose design as a constrained optimisation.
 
 The K measurement poses are chosen to make the identification of the zero
 offsets as accurate as possible, within what the robot and the measuring
@@ -332,7 +332,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         Default :func:`make_constraints` (workspace, l0 = 350 mm range,
         the robot's margin, no joint limits).
     noise : NoiseModel, optional
-        Default the paper's.
+        Default the robot's (``Robot.noise``).
     seed : int
     n_starts, exchange_starts : int
     grid : tuple of int, optional

@@ -1,4 +1,4 @@
-"""The order-free pose model of an approximate design, and its criteria (issue 13).
+"""The order-free pose model of an approximate design, and its criteria.
 
 An *approximate design* is a probability measure ``xi`` on a finite set of
 candidate poses (:mod:`zerocal_sym.design.approx`).  This module holds the

@@ -1,4 +1,4 @@
-"""Design regions beyond the workspace's shape (issue 13): the reachable set, clipped.
+"""Design regions beyond the workspace's shape: the reachable set, clipped.
 
 :class:`ReachableRegion` is the set of poses the robot reaches in the assembly
 and working mode of its home pose with every singularity indicator at least

@@ -1,4 +1,4 @@
-"""K ordered poses from a design measure: efficient rounding, replicates, visiting order (issue 13).
+"""K ordered poses from a design measure: efficient rounding, replicates, visiting order.
 
 Realisation of K poses (:func:`realize`): efficient rounding (Pukelsheim &
 Rieder 1992) of the support's weights to counts; replicates of a support

@@ -5,9 +5,12 @@ For each pose: the inverse-kinematics joints, the singularity indicators
 AD of the generated mechanism functions, at zero source errors), and the
 q-unit scaling of the sensitivities (see :mod:`zerocal_sym.design.criteria`).
 
-The design parameters are the paper's set ``robot.errors.resolve("paper")``:
-the m zero offsets then the n MAEMM components (p = m + n), in the
-mechanism's source-error order.
+The design parameters are the mechanism's identified set
+``robot.errors.resolve("paper")`` (``"paper"`` is the alias of ``"default"``):
+the m zero offsets then the measuring errors it identifies, in the mechanism's
+source-error order.  The units of the reports: joint quantities (joints, zero
+offsets, their CRLB and bias, joint limits) in the joints' file unit, keys named
+after it (:func:`okey`); poses in file units (:func:`poses_to_user`).
 """
 from __future__ import annotations
 
