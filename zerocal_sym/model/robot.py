@@ -297,6 +297,26 @@ def read_toml(path, error, what: str) -> dict:
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+)", str(exc))
         raise error(f"not valid TOML: {exc}", where=f"{path}:{m.group(1)}" if m else str(path)) from None
+    except RecursionError:  # arrays or tables nested thousands deep: the parser's recursion ends first
+        line = _deepest_line(text)
+        raise error("not valid TOML here: arrays or inline tables nested too deeply",
+                    where=f"{path}:{line}" if line else str(path)) from None
+
+
+def _deepest_line(text: str):
+    """The line (1-based) where brackets/braces nest deepest, or None."""
+    depth = best = 0
+    line = where = 1
+    for ch in text:
+        if ch == "\n":
+            line += 1
+        elif ch in "[{":
+            depth += 1
+            if depth > best:
+                best, where = depth, line
+        elif ch in "]}":
+            depth = max(depth - 1, 0)
+    return where if best else None
 
 
 def load_robot(path) -> Robot:
