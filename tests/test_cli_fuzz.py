@@ -34,7 +34,7 @@ PAPER_TOML = (ROOT / "examples" / "paper_robot.toml").read_text()
 DELTA_TOML = (ROOT / "examples" / "delta.toml").read_text()
 
 #: examples per fuzz test: the CI form, the long form
-QUICK, LONG = 12, 60
+QUICK, LONG = 40, 150
 
 # hostile TOML values for any key
 TOML_VALUES = ["0", "-1", "-0.0", "1e308", "-1e308", "1e-308", "5e-324", "DIGITS", "nan", "inf", "-inf",
@@ -401,10 +401,26 @@ def test_result_files_long(base, case):
 
 # --------------------------------------------------------------------------- study specs
 
+#: a spec whose cells hold more poses x trials than this is only loaded (--summary), not run: a fuzz case
+#: must stay a fraction of a second (trials = 100000 is a valid spec)
+RUN_LIMIT = 2000
+
+
 def _spec_case(base, edits):
+    from zerocal_sym.cli.study_spec import load_spec
+    from zerocal_sym.errors import ZerocalError
+
     with workdir(base) as t:
         spec = t / "s.toml"
         spec.write_text(apply_toml_edits(SPEC, edits))
+        try:
+            study = load_spec(spec)
+            heavy = sum(c.poses.shape[0] for c in study.cells) * study.trials > RUN_LIMIT
+        except ZerocalError:
+            heavy = False  # refused as the command will refuse it
+        if heavy:
+            check(["study", spec, "--summary", t])
+            return
         rc = check(["study", spec, "--out", t / "out", "--quiet"])
         if rc != 0:
             assert not (t / "out" / "summary.json").exists()
@@ -430,3 +446,91 @@ SPEC = ('name = "fuzz"\nseed = 0\ntrials = 4\nchunk = 2\nrobots = ["paper.toml",
         '[[design]]\nscheme = "auto"\n\n[[design]]\nscheme = "auto"\nn = 4\nrobots = ["delta"]\nlabel = "ring4"\n\n'
         '[[truth]]\nname = "g1"\nrobots = ["paper"]\ntheta1 = 2\ntheta2 = -1\nrMx = 1\n\n'
         '[[truth]]\nname = "A"\nrobots = ["delta"]\ntheta1 = 2\ntheta2 = -1\ntheta3 = 0.5\nrMz = -0.5\n')
+
+
+# --------------------------------------------------------------------------- the cases that were tracebacks
+
+@pytest.mark.parametrize("edits, seed, how", [
+    (["shuffle"], 1, "tsvd"), (["shuffle"], 1, "nlls"), (["shuffle"], 1, "huber"), (["shuffle"], 2, "nlls"),
+    (["cumulative"], 0, "tsvd"), (["drop", "shuffle"], 3, "tsvd"),
+], ids=lambda v: "+".join(v) if isinstance(v, list) else str(v))
+def test_wrong_rows_are_refused_with_their_likely_cause(base, edits, seed, how):
+    """Rows of a Delta round shuffled, cumulative or dropped: before, TSVD's report raised "the covariance of
+    the changes is not positive definite" and Ipopt's (l2, huber) "SVD did not converge" (LAPACK printed
+    "On entry to DLASCL" into the JSON on stdout).  Now: refused (exit 1), the fit check's paragraph on
+    stderr, the JSON clean."""
+    with workdir(base) as t:
+        data = t / "d.csv"
+        data.write_text(mutate_rows(base["delta"]["data_text"], edits, seed, ""))
+        extra = {"tsvd": ["--method", "tsvd"], "nlls": [], "huber": ["--loss", "huber"]}[how]
+        rc, out, err, raw = run(["identify", data, "--robot", base["delta"]["robot"], "--json", *extra])
+        assert rc == 1 and raw == "" and "Traceback" not in err, (rc, raw, err)
+        assert "no calibration written" in err and "Likely cause" in err, err
+        result = json.loads(out)
+        assert result["success"] is False and result["identifiability"]["K"] == result["data"]["K"]
+
+
+def test_reversed_rows_of_a_small_ring(base):
+    """The Delta's ring scheme with n = 4 (K = 8), rows reversed: the l2 fit and the huber loss end where the
+    model is not finite; before, "SVD did not converge"."""
+    with workdir(base) as t:
+        data = t / "r4.csv"
+        assert check(["simulate", "--robot", base["delta"]["robot"], "--scheme", "ring", "--n", "4", "--set",
+                      "theta1=2", "--set", "theta2=-1", "--set", "theta3=0.5", "--out", data], record=False) == 0
+        data.write_text(mutate_rows(data.read_text(), ["reverse"], 0, ""))
+        for extra in ([], ["--loss", "huber"], ["--loss", "soft_l1"], ["--method", "tsvd"]):
+            rc, out, err, raw = run(["identify", data, "--robot", base["delta"]["robot"], *extra])
+            assert rc == 1 and raw == "" and "Traceback" not in err and "Likely cause" in err, (extra, err)
+            assert out.strip().splitlines()[-1].startswith("verdict: rejected")
+
+
+@pytest.mark.parametrize("key, value, words", [
+    ("noise", "[1e308]", "noise factor 1e+308 must be >= 0 and at most 1000"),
+    ("noise", "[{scale = 1, servo = 1e300}]", "factors >= 0 (at most 1000)"),
+    ("chunk", "1000000000", "chunk must be a positive integer of at most 1000000"),
+    ("trials", "1000000000000", "make 100000000 chunk files per cell"),
+    ("n", "1000000000000", "n = 1000000000000: expected an integer >= 2 and <= 50000"),
+    ("rMx", "1e308", "beyond the plausible |rM| <= 50 mm"),
+    ("theta2", "1e308", "beyond the plausible 10 deg"),
+])
+def test_study_spec_values_out_of_range(base, key, value, words):
+    """Study-spec values beyond their range: one line naming the spec's line, exit 2, nothing written.
+    Before, noise = [1e308] was an OverflowError, n = 10^12 a MemoryError."""
+    lines = SPEC.splitlines()
+    if key == "trials":  # (with the default chunk)
+        lines = [ln for ln in lines if not ln.startswith("chunk")]
+    i = next(j for j, ln in enumerate(lines) if ln.startswith(f"{key} ="))
+    lines[i] = f"{key} = {value}"
+    with workdir(base) as t:
+        spec = t / "s.toml"
+        spec.write_text("\n".join(lines) + "\n")
+        rc, out, err, raw = run(["study", spec, "--out", t / "out"])
+        assert rc == 2 and len(err.strip().splitlines()) == 1, err
+        assert f"s.toml:{i + 1}: " in err and words in err, err
+        assert not (t / "out").exists()
+
+
+@pytest.mark.parametrize("where", ["robot", "study", "tolerance"])
+def test_arrays_nested_thousands_deep(base, where):
+    """A value nested 3000 arrays deep: before, a RecursionError from the TOML (or JSON) parser."""
+    deep = "[" * 3000 + "1" + "]" * 3000
+    with workdir(base) as t:
+        if where == "robot":
+            f = t / "r.toml"
+            f.write_text(PAPER_TOML.replace("L = 375", f"L = {deep}"))
+            rc, _, err, _ = run(["robot", "--robot", f])
+            line = PAPER_TOML.splitlines().index("L = 375") + 1
+        elif where == "study":
+            f = t / "s.toml"
+            f.write_text(SPEC.replace('noise = ["paper", 0.5]', f"noise = {deep}"))
+            rc, _, err, _ = run(["study", f, "--out", t / "out"])
+            line = 6
+        else:
+            f = t / "tol.json"
+            f.write_text('{"L1": ' + deep + "}")
+            rc, _, err, _ = run(["identify", base["paper"]["data"], "--robot", base["paper"]["robot"],
+                                 "--tolerance-file", f])
+            line = None
+        assert rc == 2 and len(err.strip().splitlines()) == 1 and "nested too deeply" in err, err
+        if line is not None:
+            assert f"{f.name}:{line}: " in err, err

@@ -183,6 +183,9 @@ def run(args, robot):
         design.plot_design(args.plot, robot, res)
         out["plot"] = str(args.plot)
     write_out(args, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0
@@ -331,6 +334,9 @@ def _run_target(args, robot):
     out["crlb_zero_offsets_deg"] = fisher.crlb_zero_offsets_deg(robot, kin.ik(robot, P), "paper", noise).tolist()
     out = json_safe(out)
     write_out(args, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0

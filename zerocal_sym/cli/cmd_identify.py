@@ -306,6 +306,9 @@ def run(args):
             identify_plots(plot_dir, res, meas, robot, err_true=truth_from_meta(meas, robot))
         if args.out:
             write_json(args.out, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0

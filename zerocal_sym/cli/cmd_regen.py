@@ -23,6 +23,9 @@ def run(args):
 
         raise ZerocalError(f"regen needs the derivations and sympy (pip install -e '.[derive]'): {exc}") from None
     changed = regen(out_dir=args.out_dir, check=args.check)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     target = args.out_dir or GENERATED_DIR
     if args.check:
         if changed:

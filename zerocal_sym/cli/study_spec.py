@@ -369,7 +369,7 @@ def load_spec(path) -> Study:
                           ("n", lambda v: _is_int(v) and 2 <= v <= MAX_N)):
                 if k in dt and not ok(dt[k]):
                     raise StudySpecError(f"{k} = {dt[k]!r}: expected "
-                                         + (f"an integer from 2 to {MAX_N} (poses per boundary)" if k == "n" else
+                                         + (f"an integer >= 2 and <= {MAX_N} (poses per boundary)" if k == "n" else
                                             "a string"), where=wd(k))
             flt = _filter(dt, labels, wd)
             if flt is not None and rl not in flt:
