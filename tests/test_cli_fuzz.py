@@ -17,6 +17,7 @@ import contextlib
 import copy
 import io
 import json
+import math
 import os
 import random
 import shutil
@@ -34,7 +35,7 @@ PAPER_TOML = (ROOT / "examples" / "paper_robot.toml").read_text()
 DELTA_TOML = (ROOT / "examples" / "delta.toml").read_text()
 
 #: examples per fuzz test: the CI form, the long form
-QUICK, LONG = 40, 150
+QUICK, LONG = 80, 300
 
 # hostile TOML values for any key
 TOML_VALUES = ["0", "-1", "-0.0", "1e308", "-1e308", "1e-308", "5e-324", "DIGITS", "nan", "inf", "-inf",
@@ -171,9 +172,10 @@ def toml_edits(draw):
 def _number(line):
     """The number a ``key = number  # comment`` line sets, or None."""
     try:
-        return float(line.split("=", 1)[1].split("#", 1)[0])
+        v = float(line.split("=", 1)[1].split("#", 1)[0])
     except (IndexError, ValueError):
         return None
+    return v if math.isfinite(v) and abs(v) < 1e300 else None
 
 
 def apply_toml_edits(text, edits) -> str:
@@ -323,7 +325,7 @@ def test_measurement_files(base, case):
 
 
 @pytest.mark.slow
-@fuzz(3 * LONG)
+@fuzz(2 * LONG)
 @given(case=data_mutated())
 def test_measurement_files_long(base, case):
     _data_case(base, case)
@@ -397,6 +399,63 @@ def test_result_files(base, case):
 @given(case=result_mutated())
 def test_result_files_long(base, case):
     _result_case(base, case)
+
+
+# --------------------------------------------------------------------------- pose files
+
+POSES = {"paper": "x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n240,782\n",
+         "delta": "x_mm,y_mm,z_mm\n" + "".join(f"{x},{y},{z}\n" for x, y, z in (
+             (150, 0, -750), (0, 150, -750), (-150, 0, -750), (0, -150, -750), (100, 100, -850),
+             (-100, 100, -850), (-100, -100, -850), (100, -100, -850)))}
+
+
+@st.composite
+def poses_mutated(draw):
+    mech = draw(st.sampled_from(["paper", "delta"]))
+    edits = draw(st.lists(st.tuples(st.integers(0, 10**6), st.integers(0, 10**6), st.sampled_from(CELLS + [
+        "-", "1e3", "5000", "0.001"])), min_size=1, max_size=3))
+    return mech, edits, draw(st.booleans()), draw(st.sampled_from(["simulate", "template", "compare"]))
+
+
+def _poses_case(base, case):
+    mech, edits, as_json, how = case
+    rows = [ln.split(",") for ln in POSES[mech].splitlines()]
+    for i, j, value in edits:  # a cell replaced (the header too), or a row repeated / dropped
+        r = rows[i % len(rows)]
+        if value == "-" and j % 2:
+            rows.insert(j % len(rows), list(r))
+        elif value == "-":
+            rows.remove(r)
+        else:
+            r[j % len(r)] = value
+    with workdir(base) as t:
+        f = t / ("p.json" if as_json else "p.csv")
+        if as_json:
+            f.write_text('{"poses": [' + ", ".join("[" + ", ".join(c or '""' for c in r) + "]" for r in rows[1:])
+                         + "]}")
+        else:
+            f.write_text("\n".join(",".join(r) for r in rows) + "\n")
+        robot = base[mech]["robot"]
+        if how == "simulate":
+            check(["simulate", "--robot", robot, "--poses", f, "--set", "theta1=1", "--out", t / "d.csv"])
+        elif how == "template":
+            check(["compensate", base[mech]["result"], "--robot", robot, "--poses", f, "--template", "--out",
+                   t / "c.csv"])
+        else:
+            check(["compare", "--robot", robot, "--poses", f, "--trials", "2", "--methods", "tsvd", "--quiet"])
+
+
+@fuzz(QUICK)
+@given(case=poses_mutated())
+def test_pose_files(base, case):
+    _poses_case(base, case)
+
+
+@pytest.mark.slow
+@fuzz(LONG)
+@given(case=poses_mutated())
+def test_pose_files_long(base, case):
+    _poses_case(base, case)
 
 
 # --------------------------------------------------------------------------- study specs

@@ -181,7 +181,12 @@ def _is_int(v) -> bool:
 
 
 def _is_num(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(float(v))
+    if not isinstance(v, (int, float)) or isinstance(v, bool):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except OverflowError:  # an integer beyond any float
+        return False
 
 
 def _noise_levels(raw, where):
@@ -210,7 +215,8 @@ def _noise_levels(raw, where):
                                      f"{MAX_NOISE_FACTOR:g}) of the paper's two noise terms", where=where("noise"))
             out.append((f"scale{float(vals[0]):g}-servo{float(vals[1]):g}", NoiseModel.paper(*map(float, vals))))
         else:
-            raise StudySpecError(f"noise level {v!r}: a name or a number", where=where("noise"))
+            shown = f"an integer of {len(str(abs(v)))} digits" if isinstance(v, int) and abs(v) >= 10**30 else repr(v)
+            raise StudySpecError(f"noise level {shown}: a name or a finite number", where=where("noise"))
     labels = [lab for lab, _ in out]
     dup = sorted({lab for lab in labels if labels.count(lab) > 1})
     if dup:

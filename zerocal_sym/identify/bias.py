@@ -157,6 +157,14 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
         raise ZerocalError(f"tolerance scale {scale!r}: not a number") from None
     if not math.isfinite(scale) or scale < 0:
         raise ZerocalError(f"tolerance scale must be finite and >= 0, got {scale!r}")
+    from zerocal_sym.model.robot import ANGLE_LIMIT_DEG, LENGTH_LIMIT_MM
+
+    for n in names:  # (the robot file's limits: a tolerance beyond is no manufacturing error, and overflows)
+        unit = errors[n].user_unit
+        limit = ANGLE_LIMIT_DEG if unit == "deg" else LENGTH_LIMIT_MM
+        if errors.to_user_value(n, tol[n]) * scale > limit:
+            raise ZerocalError(f"tolerance {n} = {errors.to_user_value(n, tol[n]) * scale:g} {unit}"
+                               + (f" (x {scale:g})" if scale != 1 else "") + f": beyond {limit:g} {unit}")
     return Tolerances({n: tol[n] * scale for n in names}, bias_model)
 
 

@@ -53,6 +53,11 @@ PAPER_TABLE1 = dict(ex=80.0, ey=0.0, L=375.0, l=825.0, H=632.0, b=480.0, h=150.0
 DEFAULT_SINGULARITY_MARGIN = 0.2
 #: home joint angles beyond this are a unit or typing error (deg; the data files' limit)
 HOME_LIMIT_DEG = 3600.0
+#: a length (mm) in a robot file beyond this is no robot's (1 km, the data files' limit too; the distances'
+#: arithmetic overflows far beyond)
+LENGTH_LIMIT_MM = 1e6
+#: a geometric angle (deg) in a robot file beyond this is a unit or typing error
+ANGLE_LIMIT_DEG = 360.0
 TOP_KEYS = ("name", "mechanism", "units", "singularity_margin", "home")
 TABLES = ("geometry", "workspace")
 
@@ -226,6 +231,10 @@ def _check_number(k, v, unit, where):
         raise RobotFileError(f"key '{k}' must be a number ({unit}), got {v!r}", where=where(k))
     if not _is_finite_number(v):
         raise RobotFileError(f"key '{k}' must be a finite number, got {_shown(v)}", where=where(k))
+    limit = ANGLE_LIMIT_DEG if unit == "deg" else LENGTH_LIMIT_MM
+    if abs(float(v)) > limit:
+        raise RobotFileError(f"key '{k}' = {_shown(v)} {unit} is beyond +-{limit:g} {unit}: not a robot's "
+                             f"(robot files are in mm and degrees)", where=where(k))
 
 
 def _check_keys(keys: dict, where) -> None:
