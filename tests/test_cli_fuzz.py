@@ -529,6 +529,18 @@ def test_wrong_rows_are_refused_with_their_likely_cause(base, edits, seed, how):
         assert result["success"] is False and result["identifiability"]["K"] == result["data"]["K"]
 
 
+def test_a_nonsense_estimate_is_not_accepted_despite_misfit(base):
+    """--accept-misfit keeps a fit the noise model rejects, not an estimate where the model cannot even be
+    evaluated (TSVD on shuffled rows ends at a MAEMM of metres): refused, exit 1, nothing written."""
+    with workdir(base) as t:
+        data = t / "d.csv"
+        data.write_text(mutate_rows(base["delta"]["data_text"], ["shuffle"], 1, ""))
+        rc, out, err, raw = run(["identify", data, "--robot", base["delta"]["robot"], "--method", "tsvd",
+                                 "--accept-misfit", "--out", t / "r.json"])
+        assert rc == 1 and raw == "" and "the exact model cannot be evaluated at the estimate" in err, err
+        assert not (t / "r.json").exists()
+
+
 def test_reversed_rows_of_a_small_ring(base):
     """The Delta's ring scheme with n = 4 (K = 8), rows reversed: the l2 fit and the huber loss end where the
     model is not finite; before, "SVD did not converge"."""

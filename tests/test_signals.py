@@ -177,6 +177,31 @@ def test_a_signal_before_the_outputs_stops_the_command(tmp_path, capsys, monkeyp
     assert capsys.readouterr().err == "zerocal simulate: interrupted\n" and not out.exists()
 
 
+def test_the_handler_decides_by_where_the_command_is():
+    """Inside the command's run the handler raises; in call() itself (the command not started yet, or just
+    returned) it does not, and leaves the decision to its re-trip; after the command it does nothing.  Before,
+    a SIGINT landing after run() had returned still made the status 130."""
+    with _interrupt.installed() as guard:
+        guard._kick = lambda: None  # (no re-trip: this test calls the handler itself)
+        inside = []
+
+        def run():
+            inside.append(sys._getframe())
+            return sys._getframe(1)  # call()'s own frame
+
+        between = guard.call(run)
+        assert between.f_code is _interrupt._CALL_CODE
+        guard.done = False  # as if the command were still running
+        with pytest.raises(KeyboardInterrupt):
+            guard.handler(signal.SIGINT, inside[0])
+        assert guard.handler(signal.SIGINT, between) is None  # at the boundary: no raise
+        guard.done = True
+        assert guard.handler(signal.SIGTERM, inside[0]) is None  # finished: nothing
+        assert _interrupt.interrupt_status() == (143, "terminated")
+    _interrupt.reset()
+    assert _interrupt.interrupt_status() == (130, "interrupted")
+
+
 # --------------------------------------------------------------------------- workers die with the command
 
 def _workers_started(p, n=2, timeout=120.0):
