@@ -184,7 +184,8 @@ def apply(result, fit: dict, accept_misfit: bool = False):
             result.status = f"accepted despite misfit ({_summary(fit)}); {result.status}"
         else:
             result.success = False
-            result.status = (f"rejected: the noise model rejects the fit ({_summary(fit)})" if math.isfinite(fit["chi2"])
-                             else "rejected: the exact model cannot be evaluated at the estimate (a pose is not an "
-                                  "assembly of the robot with those errors)")
+            result.status = (f"rejected: the noise model rejects the fit ({_summary(fit)})"
+                             if math.isfinite(fit["chi2"]) else
+                             "rejected: the exact model cannot be evaluated at the estimate (a pose is not an "
+                             "assembly of the robot with those errors)")
     return result
