@@ -96,7 +96,7 @@ def test_compensate_refuses_implausible_offset(capsys, tmp_path):
     res = tmp_path / "r.json"
     assert zc(capsys, "identify", data, "--out", res)[0] == 0
     d = json.loads(res.read_text())
-    d["zero_offsets_deg"][0] = 20.0
+    d["zero_offsets_deg"][0] = d["estimate"]["theta1"] = d["compensation"]["offset_deg"][0] = 20.0  # every copy
     res.write_text(json.dumps(d))
     table = tmp_path / "table.csv"
     rc, o, err = zc(capsys, "compensate", res, "--out", table)

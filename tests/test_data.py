@@ -434,10 +434,10 @@ def _result_json(**over):
 
 
 def test_load_result(tmp_path):
-    r = load_result(write(tmp_path, _result_json(robot_sha256="ab"), "r.json"))
+    r = load_result(write(tmp_path, _result_json(robot_sha256="AB" * 32), "r.json"))
     np.testing.assert_array_equal(r.zero_offsets_deg, [2.0, -1.0])
     assert r.std_zero_offsets_deg[0] == 0.05 and np.isnan(r.std_zero_offsets_deg[1])
-    assert r.robot_sha256 == "ab" and r.method == "tsvd" and r.success
+    assert r.robot_sha256 == "ab" * 32 and r.method == "tsvd" and r.success
 
 
 @pytest.mark.parametrize("text,pattern", [

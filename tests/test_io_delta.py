@@ -298,7 +298,7 @@ def test_delta_result_round_trip_from_identification_result(tmp_path, delta):
     ({"mechanism": "hexapod"}, None, r"unknown mechanism \"hexapod\"", "mechanism"),
     ({"estimate": {"theta1": 2.0, "e1x": 0.1}}, None, r"key 'estimate': unknown parameter 'e1x' of mechanism "
      r"delta_rotary", "estimate"),
-    ({"units": {"theta1": "rad"}}, None, r"the unit of 'theta1' must be \"deg\" or \"mm\"", "units"),
+    ({"units": {"theta1": "rad"}}, None, r"the unit of 'theta1' must be \"deg\", got \"rad\"", "units"),
 ])
 def test_bad_delta_result(tmp_path, robot, delta, over, robot_kind, pattern, key):
     text = _delta_result(**over)

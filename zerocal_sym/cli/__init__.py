@@ -42,8 +42,10 @@ def _command_modules():
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from zerocal_sym.cli._paths import InputFile, path_options
+
     common = _Parser(add_help=False)
-    common.add_argument("--robot", metavar="FILE", default=None,
+    common.add_argument("--robot", metavar="FILE", default=None, type=InputFile("the robot file"),
                         help="robot TOML file, any mechanism (default: the paper's robot, Table 1; "
                              "examples/delta.toml: the rotary Delta)")
     parser = _Parser(
@@ -54,7 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.__doc__, parents=[common],
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(p)
-        p.set_defaults(_run=mod.run)
+        p.set_defaults(_run=mod.run, _paths=path_options(p))  # the files it reads and writes (cli/_paths.py)
     return parser
 
 

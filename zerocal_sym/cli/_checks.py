@@ -19,9 +19,11 @@ The rules:
   ``--json`` (the JSON holds the report); ``regen``/``study --robot``.
 * **Numbers**: seeds are integers >= 0; counts in their range (``--n`` at most
   :data:`MAX_N` poses per boundary); thresholds finite and positive.
-* **Files**: no empty names; an output that is one of the command's inputs
-  (the same file however named) or another of its outputs is refused
-  (:func:`zerocal_sym.io.files.check_outputs`).
+* **Files**, first, for every command alike: the options declare what they
+  read and write (:mod:`zerocal_sym.cli._paths`); no empty names; an output
+  that lands on one of the command's inputs (the same file however named) or
+  on another of its outputs is refused
+  (:func:`zerocal_sym.cli._paths.check_paths`).
 """
 from __future__ import annotations
 
@@ -33,12 +35,6 @@ from zerocal_sym.errors import ZerocalError
 MAX_N = 50_000
 #: a MAEMM prior beyond this is not a manufacturing error of the measuring mechanism (mm)
 MAEMM_PRIOR_LIMIT_MM = 1000.0
-
-#: the files ``identify --plot DIR`` / ``verify --plot DIR`` / ``reproduce --out DIR`` write into DIR
-IDENTIFY_PLOTS = ("residuals.png", "boundary_errors.png")
-VERIFY_PLOTS = ("residuals.png",)
-REPRODUCE_FILES = (("fig8.png", "fig9.png", "results.json") + tuple(f"fig12_group{g}.png" for g in range(1, 7))
-                   + tuple(f"convergence_group{g}.png" for g in range(1, 7)))
 
 #: design options that belong to --optimize (dest names)
 DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
@@ -103,20 +99,6 @@ def _positive(args, dest, what, allow_zero=False) -> None:
                            f"number{what}, got {v:g}")
 
 
-def _file_args(args, *pairs) -> None:
-    """``(label, value)``: a file name given as the empty string is an error."""
-    for label, v in pairs:
-        if v is not None and str(v) == "":
-            raise ZerocalError(f"{label}: empty file name")
-
-
-def _outputs(args, outputs, inputs) -> None:
-    from zerocal_sym.io.files import check_outputs
-
-    robot = getattr(args, "robot", None)
-    check_outputs(outputs, list(inputs) + [("the robot file", robot)])
-
-
 def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
     """Why the parameters ``names`` cannot be identified from the poses ``theta_cmd`` (a phrase), or None.
 
@@ -168,6 +150,18 @@ def _trust(args) -> None:
     _positive(args, "max_maemm_mm", " of mm")
 
 
+def _prior_within_plausible(args) -> None:
+    """A MAEMM prior the plausibility check (``--max-maemm-mm``) would refuse is an error now, naming the prior."""
+    v, limit = getattr(args, "maemm_prior", None), getattr(args, "max_maemm_mm", None)
+    if v is None or limit is None or not all(math.isfinite(x) for x in v):
+        return
+    norm = math.sqrt(sum(x * x for x in v))
+    if norm > limit:
+        raise ZerocalError(f"--maemm-prior {' '.join(f'{x:g}' for x in v)}: |rM| = {norm:.4g} mm is beyond "
+                           f"--max-maemm-mm {limit:g}: a result near this prior would be refused as implausible "
+                           "(a MAEMM that large is a wrong c / d in the robot file)")
+
+
 def _identify(args) -> None:
     _trust(args)
     if args.method == "tsvd":
@@ -187,12 +181,10 @@ def _identify(args) -> None:
         if args.max_iter is not None and args.max_iter < 1:
             raise ZerocalError(f"--max-iter must be >= 1, got {args.max_iter}")
     _maemm_prior(args)
+    _prior_within_plausible(args)
     if args.report and args.json:
         raise ZerocalError("--report is for the text output: the JSON (--json) holds the report under "
                            "'identifiability'")
-    _file_args(args, ("DATA.csv", args.data))
-    _outputs(args, [("--out", args.out), ("--plot", args.plot, IDENTIFY_PLOTS)],
-             [("the measurement file", args.data)])
 
 
 def _compensate(args) -> None:
@@ -201,23 +193,16 @@ def _compensate(args) -> None:
                            "there is no offset to check)")
     if args.max_offset_deg is not None:
         _positive(args, "max_offset_deg", " of degrees")
-    _file_args(args, ("RESULT.json", args.result), ("--poses", args.poses))
     _n(args)
-    _outputs(args, [("--out", args.out)], [("the results file", args.result), ("the pose file", args.poses)])
 
 
 def _verify(args) -> None:
     _trust(args)
-    _file_args(args, ("RESULT.json", args.result), ("DATA.csv", args.data))
-    _outputs(args, [("--out", args.out), ("--plot", args.plot, VERIFY_PLOTS)],
-             [("the results file", args.result), ("the measurement file", args.data)])
 
 
 def _simulate(args) -> None:
     _seed(args)
     _n(args)
-    _file_args(args, ("--poses", args.poses))
-    _outputs(args, [("--out", args.out)], [("the pose file", args.poses)])
 
 
 def _compare(args) -> None:
@@ -238,9 +223,6 @@ def _compare(args) -> None:
     if args.max_iter is not None and args.max_iter < 1:
         raise ZerocalError(f"--max-iter must be >= 1 (identifications per loop), got {args.max_iter}")
     _positive(args, "mu0", " of degrees")
-    poses = args.poses if args.poses not in ("paper", "ring") else None
-    _file_args(args, ("--poses", poses))
-    _outputs(args, [("--out", args.out)], [("the pose file", poses)])
 
 
 def _design(args) -> None:
@@ -265,10 +247,6 @@ def _design(args) -> None:
     _seed(args)
     _n(args)
     _maemm_prior(args)
-    outputs = [("--plot", getattr(args, "plot", None))]
-    if hasattr(args, "out"):
-        outputs.insert(0, ("--out", args.out))
-    _outputs(args, outputs, [])
 
 
 def _reproduce(args) -> None:
@@ -276,24 +254,17 @@ def _reproduce(args) -> None:
     _n(args)
     if _given(args, "truncation") and _given(args, "rule"):
         raise ZerocalError("--truncation fixes the truncation level: not with --rule (a rule chooses it)")
-    _outputs(args, [("--out", args.out, REPRODUCE_FILES)], [])
 
 
 def _regen(args) -> None:
     if _given(args, "robot"):
         raise ZerocalError("--robot: regen reads no robot file (it regenerates the code of every mechanism "
                            "from derivations/)")
-    if args.out_dir is not None and args.out_dir == "":
-        raise ZerocalError("--out-dir: empty directory name")
 
 
 def _study(args) -> None:
     if _given(args, "robot"):
         raise ZerocalError("--robot: a study's robots are in its spec (robots = [...])")
-    _file_args(args, ("SPEC.toml", args.spec))
-    out = getattr(args, "out", None)
-    if out is not None:
-        _outputs(args, [("--out", out, ())], [("the study spec", args.spec)])
 
 
 CHECKS = {"identify": _identify, "compensate": _compensate, "verify": _verify, "simulate": _simulate,
@@ -302,9 +273,9 @@ CHECKS = {"identify": _identify, "compensate": _compensate, "verify": _verify, "
 
 def check_args(args) -> None:
     """Check the options of ``args.command`` (module docstring); a ZerocalError names the option."""
-    robot = getattr(args, "robot", None)
-    if robot is not None and robot == "":
-        raise ZerocalError("--robot: empty file name")
+    from zerocal_sym.cli._paths import check_paths
+
+    check_paths(args)  # every command alike, from the options' declarations
     check = CHECKS.get(getattr(args, "command", None))
     if check is not None:
         check(args)

@@ -37,7 +37,9 @@ def add_arguments(p):
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
                    help="tolerance of an error the identification leaves out (mm; deg for angles), repeatable; "
                         "default: set A of Table 2 (planar), 0.02 mm per length and 0.002 deg per angle (others)")
-    p.add_argument("--tolerance-file", default=None, metavar="FILE",
+    from zerocal_sym.cli._paths import InputFile
+
+    p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
                    help="tolerances as name = value (TOML or JSON; mm, deg)")
     p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S",
                    help="every tolerance times S (e.g. 10)")

@@ -38,6 +38,9 @@ HELP = "Monte Carlo of TSVD vs Ipopt (one-shot, in the loop) vs scipy on the sam
 
 
 def add_arguments(p):
+    from zerocal_sym.cli._common import scheme_names
+    from zerocal_sym.cli._paths import InputFile, OutputFile
+
     p.add_argument("--trials", type=int, default=100, help="trials per group (default 100)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--set", action="append", default=None, metavar="NAME=VALUE",
@@ -46,7 +49,7 @@ def add_arguments(p):
     g.add_argument("--group", type=int, default=None,
                    help="Table 2 group 1..6 (the paper's robot only; its default: 1)")
     g.add_argument("--all", action="store_true", help="all six groups of Table 2 (the paper's robot only)")
-    p.add_argument("--poses", default=None, metavar="paper|ring|FILE",
+    p.add_argument("--poses", default=None, metavar="paper|ring|FILE", type=InputFile("the pose file", not_files=scheme_names),
                    help="measurement poses: the robot's scheme (default; with --n) or a pose file "
                         "[pose,]x_mm,y_mm[,z_mm]")
     p.add_argument("--n", type=int, default=None, help="poses per boundary of the scheme (default: 3 paper, 6 ring)")
@@ -69,7 +72,7 @@ def add_arguments(p):
 
     _parallel.add_arguments(p)
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.add_argument("--out", metavar="FILE.json", default=None, help="also write the JSON here")
+    p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="also write the JSON here")
 
 
 def run(args):

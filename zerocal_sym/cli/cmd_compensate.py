@@ -29,10 +29,12 @@ HELP = "write the compensation table / compensated joint commands from a result"
 
 
 def add_arguments(p):
-    p.add_argument("result", metavar="RESULT.json", nargs="?", default=None,
+    from zerocal_sym.cli._paths import InputFile, OutputFile
+
+    p.add_argument("result", metavar="RESULT.json", nargs="?", default=None, type=InputFile("the results file"),
                    help="results file of 'zerocal identify --json' (omit for no compensation, with --template)")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--poses", metavar="FILE.csv", default=None,
+    g.add_argument("--poses", metavar="FILE.csv", default=None, type=InputFile("the pose file"),
                    help="target positions: CSV [pose,]x_mm,y_mm[,z_mm] or design JSON")
     g.add_argument("--scheme", choices=["paper", "ring"], default=None,
                    help="the robot's boundary scheme, 2n poses (paper: rectangle, ring: cylinder)")
@@ -42,7 +44,7 @@ def add_arguments(p):
                    help="write a measurement file to fill in (reading_mm blank) instead of a command table")
     p.add_argument("--max-offset-deg", type=float, default=10.0,
                    help="refuse offsets larger than this (default 10 deg: not a zero offset)")
-    p.add_argument("--out", metavar="FILE.csv", default=None, help="output file (default: print)")
+    p.add_argument("--out", metavar="FILE.csv", default=None, type=OutputFile(), help="output file (default: print)")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
 
 

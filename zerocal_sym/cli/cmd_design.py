@@ -27,6 +27,8 @@ HELP = "measurement poses: the robot's boundary scheme (paper, ring) or an optim
 
 
 def add_arguments(p):
+    from zerocal_sym.cli._paths import OutputFile
+
     p.add_argument("--scheme", choices=["paper", "ring"], default=None,
                    help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
     p.add_argument("--n", type=int, default=None,
@@ -49,9 +51,9 @@ def add_arguments(p):
     from zerocal_sym.cli import _parallel
 
     _parallel.add_arguments(p, "--verify")
-    p.add_argument("--plot", metavar="PNG", default=None, help="plot the poses in the workspace")
+    p.add_argument("--plot", metavar="PNG", default=None, type=OutputFile(), help="plot the poses in the workspace")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.add_argument("--out", metavar="FILE.json", default=None, help="also write the JSON (what --json prints) here")
+    p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="also write the JSON (what --json prints) here")
     # --optimize constraints and settings (issue 5; defaults in zerocal_sym.design)
     p.add_argument("--l0", type=float, default=350.0, metavar="MM",
                    help="scale range l0 in mm (--optimize; default 350, the paper's)")

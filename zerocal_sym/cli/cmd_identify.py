@@ -30,8 +30,14 @@ NAME = "identify"
 HELP = "identify zero offsets and MAEMM from a measurement file (Ipopt or TSVD)"
 
 
+#: the files ``--plot DIR`` writes into DIR
+PLOTS = ("residuals.png", "boundary_errors.png")
+
+
 def add_arguments(p):
-    p.add_argument("data", metavar="DATA.csv", help="measurement file (format: docs/data-format.md)")
+    from zerocal_sym.cli._paths import InputFile, OutputDir, OutputFile
+
+    p.add_argument("data", metavar="DATA.csv", type=InputFile("the measurement file"), help="measurement file (format: docs/data-format.md)")
     p.add_argument("--method", choices=["nlls", "tsvd"], default="nlls", help="identification method (default nlls)")
     p.add_argument("--params", default="paper",
                    help="nlls parameter set: paper (the zero offsets and the MAEMM, e.g. theta1 theta2 rMx rMy) "
@@ -57,11 +63,12 @@ def add_arguments(p):
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
                    help="tolerance of a source error left out of the identification (mm; deg for angles), for the "
                         "bias the estimate may carry (default: the mechanism's, docs/design.md); repeatable")
-    p.add_argument("--tolerance-file", default=None, metavar="FILE", help="tolerances by name (TOML or JSON)")
+    p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
+                   help="tolerances by name (TOML or JSON)")
     p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S", help="every tolerance times S")
     p.add_argument("--json", action="store_true", help="print the results JSON")
-    p.add_argument("--out", metavar="FILE.json", default=None, help="write the results JSON here")
-    p.add_argument("--plot", metavar="DIR", default=None,
+    p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="write the results JSON here")
+    p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
                    help="write residuals.png (measured minus predicted change per pose) into DIR and, for "
                         "simulated data (a '# true_errors:' line), boundary_errors.png (position error over the "
                         "workspace boundary before/after the compensation)")

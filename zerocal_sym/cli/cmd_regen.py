@@ -10,7 +10,10 @@ HELP = "regenerate zerocal_sym/generated/ from derivations/ (needs sympy)"
 
 def add_arguments(p):
     p.add_argument("--check", action="store_true", help="compare only; exit 1 if stale")
-    p.add_argument("--out-dir", default=None, help="write into this directory instead")
+    from zerocal_sym.cli._paths import OutputDir
+
+    p.add_argument("--out-dir", default=None, metavar="DIR", type=OutputDir(("*.py",)),
+                   help="write into this directory instead")
 
 
 def run(args):

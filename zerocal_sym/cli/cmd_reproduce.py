@@ -20,7 +20,14 @@ NAME = "reproduce"
 HELP = "run Table 2's six groups through the loop; Tables 3-6 and Figs. 8-9 vs the paper"
 
 
+#: the files ``--out DIR`` writes into DIR
+FILES = (("fig8.png", "fig9.png", "results.json") + tuple(f"fig12_group{g}.png" for g in range(1, 7))
+         + tuple(f"convergence_group{g}.png" for g in range(1, 7)))
+
+
 def add_arguments(p):
+    from zerocal_sym.cli._paths import OutputDir
+
     p.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
     p.add_argument("--trials", type=int, default=1, help="seeds per group; mean ± std (default 1)")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
@@ -34,7 +41,7 @@ def add_arguments(p):
                    help="fixed TSVD truncation level 1..4 (default: the --rule)")
     p.add_argument("--rule", choices=["threshold", "gcv", "discrepancy"], default="threshold",
                    help="automatic TSVD truncation rule (default threshold: keeps all 4)")
-    p.add_argument("--out", metavar="DIR", default=None,
+    p.add_argument("--out", metavar="DIR", default=None, type=OutputDir(FILES),
                    help="write fig8.png, fig9.png, results.json and, per group, fig12_group{g}.png "
                         "(position error on the 42 boundary positions before/after) and "
                         "convergence_group{g}.png here")

@@ -44,6 +44,8 @@ HELP = "simulate one identification round (true errors by --set, or a Table 2 gr
 
 
 def add_arguments(p):
+    from zerocal_sym.cli._paths import InputFile, OutputFile
+
     truth = p.add_mutually_exclusive_group(required=True)
     truth.add_argument("--set", action="append", default=None, metavar="NAME=VALUE",
                        help="a true source error (robot frame; deg for angles, mm otherwise), repeatable; "
@@ -56,7 +58,7 @@ def add_arguments(p):
     poses = p.add_mutually_exclusive_group()
     poses.add_argument("--scheme", choices=["paper", "ring"], default=None,
                        help="pose scheme (default: the robot's: paper on a rectangle, ring on a cylinder)")
-    poses.add_argument("--poses", metavar="FILE", default=None,
+    poses.add_argument("--poses", metavar="FILE", default=None, type=InputFile("the pose file"),
                        help="pose list instead of a scheme: CSV [pose,]x_mm,y_mm[,z_mm] or design JSON")
     p.add_argument("--n", type=int, default=None,
                    help="poses per boundary of the scheme, K = 2n (default: 3 paper, 6 ring)")
@@ -65,7 +67,7 @@ def add_arguments(p):
                         "commanded = IK - compensation")
     p.add_argument("--frame", choices=["paper", "literal"], default=None,
                    help="how Table 2 is read with --group (default: paper = mirrored about x)")
-    p.add_argument("--out", required=True, metavar="FILE.csv", help="output measurement file")
+    p.add_argument("--out", required=True, metavar="FILE.csv", type=OutputFile(), help="output measurement file")
 
 
 def true_errors(args, robot):

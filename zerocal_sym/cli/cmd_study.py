@@ -24,6 +24,8 @@ Examples:
 """
 NAME = "study"
 HELP = "a Monte Carlo study over robots, designs, noise levels and truths (chunked, resumable)"
+#: the files ``--out DIR`` writes into DIR (cli/study.py, cli/study_chunks.py: chunk_path, _cell_json)
+FILES = ("summary.json", "*/cell.json", "*/chunk-*.npz")
 
 
 def _hide_robot(p):
@@ -51,11 +53,14 @@ def _hide_robot(p):
 def add_arguments(p):
     from zerocal_sym.cli import _parallel
 
+    from zerocal_sym.cli._paths import InputDir, InputFile, OutputDir
+
     _hide_robot(p)
-    p.add_argument("spec", metavar="SPEC.toml", help="the study spec")
+    p.add_argument("spec", metavar="SPEC.toml", type=InputFile("the study spec"), help="the study spec")
     g = p.add_mutually_exclusive_group(required=True)
-    g.add_argument("--out", metavar="DIR", help="run the study into DIR (resumes what is there)")
-    g.add_argument("--summary", metavar="DIR", help="only summarise the chunks in DIR")
+    g.add_argument("--out", metavar="DIR", type=OutputDir(FILES), help="run the study into DIR (resumes what is there)")
+    g.add_argument("--summary", metavar="DIR", type=InputDir("the study directory"),
+                   help="only summarise the chunks in DIR")
     _parallel.add_arguments(p, "the identifications")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no account of the chunks")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -112,6 +117,10 @@ def run(args):
                                "files on disk")
     mode()  # ZEROCAL_COMPILE: a bogus value is a user error before anything is read or written
     spec = load_spec(args.spec)
+    if args.out is not None:  # the files the spec names are inputs too (the spec itself: cli/_checks.py)
+        from zerocal_sym.io.files import check_outputs
+
+        check_outputs([("--out", args.out, FILES)], spec.inputs)
     if args.summary is not None:
         if Path(args.summary).is_file():
             raise ZerocalError("is a file" + (" (the spec?)" if Path(args.summary).suffix == ".toml" else "")

@@ -23,17 +23,23 @@ NAME = "verify"
 HELP = "re-identify with the compensation applied; pass if the remaining offset mu < mu0"
 
 
+#: the files ``--plot DIR`` writes into DIR
+PLOTS = ("residuals.png",)
+
+
 def add_arguments(p):
-    p.add_argument("result", metavar="RESULT.json", help="the applied result (zerocal identify --json / verify --out)")
-    p.add_argument("data", metavar="DATA.csv", help="measurements taken with that compensation applied")
+    from zerocal_sym.cli._paths import InputFile, OutputDir, OutputFile
+
+    p.add_argument("result", metavar="RESULT.json", type=InputFile("the results file"), help="the applied result (zerocal identify --json / verify --out)")
+    p.add_argument("data", metavar="DATA.csv", type=InputFile("the measurement file"), help="measurements taken with that compensation applied")
     p.add_argument("--method", choices=["tsvd", "nlls"], default="tsvd", help="identification method (default tsvd)")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
                    help="noise model for weights and covariance (default paper)")
     p.add_argument("--mu0", type=float, default=0.1, help="threshold of the compensation accuracy mu, deg (0.1)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.add_argument("--out", metavar="FILE.json", default=None,
+    p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(),
                    help="write the new result (readable by compensate and verify), atomically")
-    p.add_argument("--plot", metavar="DIR", default=None,
+    p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
                    help="write residuals.png (residuals per pose of the re-identification) into DIR")
     from zerocal_sym.cli.cmd_identify import add_trust_arguments
 
@@ -99,6 +105,14 @@ def run(args):
     joints = robot.mechanism.joint_names
     applied = load_result(args.result, robot=robot)
     check_result_robot(applied, robot, args.result)
+    from zerocal_sym.identify.fitcheck import plausibility
+
+    reasons = plausibility(robot, applied, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
+    if reasons:  # as compensate: not a calibration to verify (and not a prior for the re-identification)
+        import sys
+
+        print(f"zerocal verify: refused {args.result}: {'; '.join(reasons)}", file=sys.stderr)
+        return 1
     meas = load_measurements(args.data, robot)
     declared = parse_offsets(meas.meta.get("compensation_deg"), robot.m)
     if declared is not None and np.max(np.abs(declared - applied.zero_offsets_deg)) > 1e-4:
@@ -132,8 +146,6 @@ def run(args):
         if diagnosis(res):
             print(diagnosis(res), file=sys.stderr)
         return 1
-    from zerocal_sym.identify.fitcheck import plausibility
-
     reasons = plausibility(robot, res, max_offset_deg=args.max_offset_deg, max_maemm_mm=args.max_maemm_mm)
     if reasons:
         import sys

@@ -120,6 +120,8 @@ class Study:
     params: str
     streams: str
     cells: list = field(default_factory=list)
+    #: ``[(label, path)]``: the files the spec names (robot and pose files), inputs no output may overwrite
+    inputs: list = field(default_factory=list)
 
     @property
     def chunks_per_cell(self) -> int:
@@ -311,7 +313,7 @@ def load_spec(path) -> Study:
 
     path = Path(path)
     raw = read_toml(path, StudySpecError, "study spec")
-    where = _Where(path, path.read_text())
+    where = _Where(path, path.read_text(encoding="utf-8").removeprefix("\ufeff"))
     base = path.parent
     for k in raw:
         if k not in SPEC_KEYS:
@@ -444,5 +446,7 @@ def load_spec(path) -> Study:
     if not study.cells:
         raise StudySpecError("no cell: every [[design]] or [[truth]] is filtered out for every robot",
                              where=str(path))
+    study.inputs = ([("a robot file of the spec", base / r) for r in raw["robots"] if r != "paper"]
+                    + [("a pose file of the spec", base / dt["poses"]) for dt in designs if "poses" in dt])
     return study
 

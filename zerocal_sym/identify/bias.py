@@ -175,9 +175,12 @@ def _read_file(path) -> dict:
 
     p = Path(path)
     try:
-        text = p.read_text()
+        text = p.read_text(encoding="utf-8").removeprefix("\ufeff")  # a byte-order mark is accepted
     except OSError as exc:
         raise ZerocalError(f"cannot read the tolerance file: {exc.strerror}", where=str(path)) from None
+    except UnicodeDecodeError as exc:
+        raise ZerocalError(f"cannot read the tolerance file: not UTF-8 text ({exc.reason} at byte {exc.start})",
+                           where=str(path)) from None
     try:
         data = json.loads(text) if p.suffix.lower() == ".json" else tomllib.loads(text)
     except (ValueError, tomllib.TOMLDecodeError) as exc:

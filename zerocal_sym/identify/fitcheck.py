@@ -268,7 +268,8 @@ def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
       ``max_maemm_mm`` (default 50 mm, ~7 % of the planar robot's measuring
       length: not an assembly error but a wrong ``c``/``d`` in the robot
       file);
-    * a non-finite estimate or standard deviation of an offset.
+    * a non-finite estimate or standard deviation of an offset; a MAEMM that
+      is not finite (a results file without one: unknown, not a reason).
     """
     reasons = []
     if not result.success:
@@ -291,6 +292,6 @@ def plausibility(robot, result, max_offset_deg: float = DEFAULT_MAX_OFFSET_DEG,
     if norm is not None and norm > max_maemm_mm:
         reasons.append(f"MAEMM |rM| = {norm:.4g} mm is beyond the plausible {max_maemm_mm:g} mm "
                        "(the measuring mechanism's c / d in the robot file?)")
-    elif mm.size and not np.all(np.isfinite(mm)):
+    elif mm.size and not np.all(np.isfinite(mm)) and params is not None:
         reasons.append("the MAEMM is not finite")
     return reasons

@@ -20,10 +20,9 @@ import re
 import numpy as np
 
 from zerocal_sym.io.csvtext import MECHANISM_KEY, _format_meta, get_mechanism_of, mechanism_for_shape
-from zerocal_sym.io.results import ResultFile
+from zerocal_sym.io.results import SIGN_CONVENTION, ResultFile
 
 COMPENSATION_LINE = "# zerocal compensation v1"
-SIGN_CONVENTION = "theta_cmd = IK(P) - offset_deg (actual joint angle = commanded + offset)"
 
 
 def _offsets(offsets_deg, m: int) -> np.ndarray:

@@ -29,6 +29,9 @@ from zerocal_sym.errors import DataFileError
 
 #: metadata key naming the mechanism a file belongs to (``# mechanism: delta_rotary``)
 MECHANISM_KEY = "mechanism"
+#: the metadata keys zerocal reads: one value each (a second line with another value is an error); other
+#: ``# key: value`` lines are kept and ignored, and may repeat
+READ_META_KEYS = (MECHANISM_KEY, "robot_sha256", "compensation_deg", "true_errors")
 
 #: plausibility limits of the cells (anything beyond is a unit or typing error)
 ANGLE_LIMIT_DEG = 3600.0
@@ -92,8 +95,12 @@ def _split_csv(text: str, src: str, format_prefix: str | None = None, version: i
                                         f"'{format_prefix} v{version}')", where=f"{src}:{lineno}")
             elif not header_seen and ":" in stripped:
                 k, _, v = stripped[1:].partition(":")
-                meta[k.strip()] = v.strip()
-                meta_lines[k.strip()] = lineno
+                k, v = k.strip(), v.strip()
+                if k in READ_META_KEYS and k in meta and meta[k] != v:
+                    raise DataFileError(f"'# {k}:' given twice with different values (lines {meta_lines[k]} and "
+                                        f"{lineno}): one value per key", where=f"{src}:{lineno}")
+                meta[k] = v
+                meta_lines[k] = lineno
             continue
         if '"' in line:  # quoting: the csv module (a line without quotes splits at every comma alike)
             try:

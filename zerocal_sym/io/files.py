@@ -16,10 +16,21 @@ The rules (``docs/data-format.md``, "Output files"):
   ``/dev/`` or ``/proc/`` (``/dev/stdout``, ``/dev/fd/3``) -- is written to
   as a stream, never replaced.
 * **An empty name** is an error.
+* **Where a path lands** (:func:`landing`): the absolute path with ``..``
+  and symbolic links resolved as the system resolves them once missing
+  directories are made (``nosuch/../d.csv`` is ``d.csv``, ``link/..`` the
+  parent of the link's target).  Every check and every write uses it.
+* **A file name is a file name**: an output file whose name ends in ``/``
+  (or ``.``, ``..``) names a directory and is refused.
 * **An input is never an output**: :func:`check_outputs` refuses, before any
-  work, an output that is one of the command's inputs (the same file however
-  named: a symlink, ``./``, ``..``, a hard link; compared by device and
-  inode) or another of its outputs.
+  work, an output that lands on one of the command's inputs (the same file
+  however named: ``./``, ``..`` through missing directories or symbolic
+  links, a symlink, a hard link -- compared by device and inode when the
+  file exists) or on another of its outputs; a directory of outputs is
+  refused if a file it would write there is an input.
+* **Short temporary names**: the temporary file is ``.<up to 32 characters of
+  the name>.<random>.tmp``, so any name the file system accepts can be
+  written.
 * **Directories of outputs** (``--plot DIR``, ``reproduce --out DIR``) are
   filled in a temporary directory beside them and moved into place when the
   command has succeeded (:func:`staged_directory`); a failed command leaves
@@ -28,6 +39,8 @@ The rules (``docs/data-format.md``, "Output files"):
 from __future__ import annotations
 
 import contextlib
+import fnmatch
+import glob
 import json
 import os
 import shutil
@@ -80,8 +93,33 @@ def is_stream(path, st=None) -> bool:
     p = os.fspath(path)
     if os.path.abspath(p).startswith(STREAM_PREFIXES) and os.path.islink(p):
         return True
-    st = _stat(p) if st is None else st
+    st = _stat(landing(p)) if st is None else st
     return st is not None and (stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode))
+
+
+def landing(path) -> str:
+    """Where writing ``path`` lands: absolute, ``..`` and symbolic links resolved (the module's rules).
+
+    Components that exist are resolved as the system resolves them (a
+    symbolic link to a directory, then ``..``, is the parent of its target);
+    a missing directory followed by ``..`` cancels out, as it does once a
+    writer has made the directory (``nosuch/../d.csv`` is ``d.csv``).  A
+    symbolic link as the last component is resolved too: a write goes through
+    it.
+    """
+    return os.path.realpath(os.fspath(path))
+
+
+def names_a_directory(path) -> bool:
+    """Whether a file name ends in ``/``, ``/.`` or ``/..`` (or is ``.``, ``..``): a directory, not a file."""
+    p = os.fspath(path)
+    return p.endswith(os.sep) or (os.altsep is not None and p.endswith(os.altsep)) or \
+        os.path.basename(p) in (".", "..")
+
+
+def _temp_prefix(name: str) -> str:
+    """``.<name, at most 32 characters>.``: a temporary name any file system accepts beside a valid name."""
+    return f".{name[:32]}."
 
 
 def _created_parents(parent: Path) -> list:
@@ -106,10 +144,13 @@ def _remove_dirs(dirs) -> None:
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` all-or-nothing (the module's rules).
 
+    The file written is :func:`landing` of ``path`` (missing parent
+    directories are made, and removed again if the write fails).
+
     Raises
     ------
     OutputError
-        An empty name, a block device or a socket.
+        An empty name, a name ending in ``/``, a block device or a socket.
     OSError
         With ``filename`` the user's ``path``: a directory given, no
         permission, a full disk, ...
@@ -117,7 +158,13 @@ def atomic_write_bytes(path, data: bytes) -> None:
     p = os.fspath(path)
     if p == "":
         raise OutputError("empty output file name")
-    st = _stat(p)
+    if names_a_directory(p):
+        raise OutputError("ends in a directory separator or '.': a file name is expected", where=p)
+    target = Path(landing(p))
+    try:
+        st = _stat(os.fspath(target))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, p) from None
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise IsADirectoryError(21, "is a directory, expected a file name", p)
     if is_stream(p, st):
@@ -129,13 +176,12 @@ def atomic_write_bytes(path, data: bytes) -> None:
         return
     if st is not None and not stat.S_ISREG(st.st_mode):
         raise OutputError(f"is {_kind(st.st_mode)}, not a regular file: not replaced", where=p)
-    target = Path(os.path.realpath(p)) if os.path.islink(p) else Path(p)
     mode = (st.st_mode & 0o777) if st is not None else (0o666 & ~current_umask())
     created, tmp, done = [], None, False
     try:
-        if not os.path.islink(p):
+        if not os.path.islink(p):  # a dangling link: its directory is not made
             created = _created_parents(target.parent)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+        fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(target.name), suffix=".tmp", dir=target.parent)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             os.fchmod(fh.fileno(), mode)
@@ -161,9 +207,16 @@ def atomic_write_text(path, text: str) -> None:
 def _check_one(option: str, path: str, kind: str) -> None:
     if path == "":
         raise OutputError(f"{option}: empty {'file' if kind == 'file' else 'directory'} name")
-    st = _stat(path)
+    if kind == "file" and names_a_directory(path):
+        raise OutputError(f"{option}: ends in a directory separator or '.', which names a directory: give a file "
+                          "name", where=path)
+    land = landing(path)
+    try:
+        st = _stat(land)
+    except OSError as exc:
+        raise OutputError(f"{option}: {exc.strerror}", where=path) from None
     if st is None:
-        parent = os.path.dirname(os.path.abspath(path))
+        parent = os.path.dirname(land)
         while parent and not os.path.exists(parent):  # the nearest existing ancestor must be a directory
             up = os.path.dirname(parent)
             if up == parent:
@@ -182,6 +235,28 @@ def _check_one(option: str, path: str, kind: str) -> None:
         raise OutputError(f"{option}: is {_kind(st.st_mode)}, not a regular file: not written", where=path)
 
 
+def _matches(rel: str, pattern: str) -> bool:
+    """Whether the relative path ``rel`` matches ``pattern`` level by level (``*`` does not cross ``/``)."""
+    parts, pats = rel.split(os.sep), pattern.split("/")
+    return len(parts) == len(pats) and all(fnmatch.fnmatchcase(a, b) for a, b in zip(parts, pats))
+
+
+def _written_in(directory: str, names) -> list:
+    """``[(landing, user path)]`` of the files an output directory would hold: its literal names, and the existing
+    files that match its patterns."""
+    out = []
+    for name in names:
+        if not any(c in name for c in "*?["):
+            user = os.path.join(directory, *name.split("/"))
+            out.append((landing(user), user))
+            continue
+        land = landing(directory)
+        if os.path.isdir(land):
+            for found in glob.glob(os.path.join(glob.escape(land), *name.split("/"))):
+                out.append((landing(found), os.path.join(directory, os.path.relpath(found, land))))
+    return out
+
+
 def check_outputs(outputs, inputs=()) -> None:
     """Refuse, before any work, outputs that cannot be written or would overwrite an input.
 
@@ -189,8 +264,8 @@ def check_outputs(outputs, inputs=()) -> None:
     ----------
     outputs : iterable of (option, path[, names])
         ``path`` None is skipped.  Without ``names`` the output is a file;
-        with ``names`` (a list of file names) it is a directory that will hold
-        those files.
+        with ``names`` (file names or ``fnmatch`` patterns, ``/`` between
+        levels) it is a directory that will hold those files.
     inputs : iterable of (label, path)
         The command's input files (``"the measurement file"``, ...); None
         paths are skipped.
@@ -198,19 +273,25 @@ def check_outputs(outputs, inputs=()) -> None:
     Raises
     ------
     OutputError
-        An empty name; a directory given for a file, or a file for a
-        directory; a block device or socket; an output that is an input (the
-        same file however named: compared by device and inode) or another
-        output.
+        An empty name; a name ending in ``/`` given for a file; a directory
+        given for a file, or a file for a directory; a block device or
+        socket; an output that lands on an input (:func:`landing`, and the
+        same device and inode) or on another output.
     """
-    ins = []
+    ins, by_land, by_inode = [], {}, {}
     for label, path in inputs:
-        if path is None:
+        if path is None or os.fspath(path) == "":
             continue
-        st = _stat(os.fspath(path))
-        if st is not None:
-            ins.append((label, os.fspath(path), st))
-    files = []  # (option, user path, path written)
+        path = os.fspath(path)
+        land = landing(path)
+        try:
+            st = _stat(land)
+        except OSError:  # unreadable: its loader says so
+            continue
+        if st is not None and stat.S_ISREG(st.st_mode):
+            ins.append((label, path, land))
+            by_land[land] = by_inode[(st.st_dev, st.st_ino)] = (label, path)
+    files = []  # (option, user path, landing)
     for item in outputs:
         option, path = item[0], item[1]
         if path is None:
@@ -219,25 +300,35 @@ def check_outputs(outputs, inputs=()) -> None:
         names = item[2] if len(item) > 2 else None
         _check_one(option, path, "file" if names is None else "dir")
         if names is None:
-            files.append((option, path, path))
-        else:
-            files += [(option, path, os.path.join(path, name)) for name in names]
-    seen = []
-    for option, user, path in files:
-        if is_stream(path):
+            if not is_stream(path):
+                files.append((option, path, landing(path)))
             continue
-        st = _stat(path)
-        if st is not None:
-            for label, ipath, ist in ins:
-                if os.path.samestat(st, ist):
-                    raise OutputError(f"{option} is {label} {ipath} (the same file): an input is never "
-                                      "overwritten; write the output elsewhere", where=path)
-        real = os.path.realpath(path)
-        for other_option, other_path, other_real, other_st in seen:
-            if real == other_real or (st is not None and other_st is not None and os.path.samestat(st, other_st)):
-                raise OutputError(f"{option} and {other_option} name the same file ({other_path}): give two "
-                                  "different outputs", where=path)
-        seen.append((option, path, real, st))
+        files += [(option, user, land) for land, user in _written_in(path, names)]
+        dland = landing(path)
+        for label, ipath, iland in ins:  # an input below the directory, under a name it writes
+            rel = os.path.relpath(iland, dland)
+            if rel != os.pardir and not rel.startswith(os.pardir + os.sep) and any(_matches(rel, pat)
+                                                                                for pat in names):
+                raise OutputError(f"{option} would overwrite {ipath}, {label}: an input is never overwritten; "
+                                  "write the output elsewhere", where=path)
+    seen_land, seen_inode = {}, {}  # of the outputs: -> (option, user path)
+    for option, user, land in files:
+        try:
+            st = _stat(land)
+        except OSError as exc:
+            raise OutputError(f"{option}: {exc.strerror}", where=user) from None
+        inode = None if st is None else (st.st_dev, st.st_ino)
+        hit = by_land.get(land) or by_inode.get(inode)
+        if hit is not None:
+            raise OutputError(f"{option} would overwrite {hit[1]}, {hit[0]}: an input is never overwritten; "
+                              "write the output elsewhere", where=user)
+        other = seen_land.get(land) or seen_inode.get(inode)
+        if other is not None and other[0] != option:
+            raise OutputError(f"{option} and {other[0]} name the same file ({other[1]}): give two different "
+                              "outputs", where=user)
+        seen_land.setdefault(land, (option, user))
+        if inode is not None:
+            seen_inode.setdefault(inode, (option, user))
 
 
 @contextlib.contextmanager
@@ -259,15 +350,18 @@ def staged_directory(path):
     p = os.fspath(path)
     if p == "":
         raise OutputError("empty directory name")
-    out = Path(p)
-    st = _stat(p)
+    out = Path(landing(p))
+    try:
+        st = _stat(os.fspath(out))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, p) from None
     if st is not None and not stat.S_ISDIR(st.st_mode):
         raise OutputError(f"is {_kind(st.st_mode)}, not a directory", where=p)
     created = []
     try:
         if st is None:
             created = _created_parents(out.parent)
-            tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+            tmp = Path(tempfile.mkdtemp(prefix=_temp_prefix(out.name), suffix=".tmp", dir=out.parent))
         else:
             tmp = Path(tempfile.mkdtemp(prefix=".zerocal.", suffix=".tmp", dir=out))
     except OSError as exc:

@@ -2,6 +2,9 @@
 
 * :func:`_declared_mechanism`, :func:`_check_columns_fit_robot` -- the
   ``# mechanism:`` line and the columns against the robot's mechanism;
+* :func:`_check_metadata` -- the ``# robot_sha256:`` line is a SHA-256 (64
+  hexadecimal digits), the ``# compensation_deg:`` line one finite angle per
+  joint;
 * :func:`_check_duplicates` -- no pose repeats an earlier one;
 * :func:`check_against_robot` -- every commanded pose reachable and inside
   the workspace (within :data:`WORKSPACE_TOL_MM`), the targets within
@@ -30,6 +33,22 @@ WORKSPACE_TOL_MM = 25.0
 TARGET_TOL_MM = 50.0
 #: two poses whose commanded angles agree to this (deg) are the same pose
 DUPLICATE_TOL_DEG = 1e-9
+
+
+def _check_metadata(meta, meta_lines, src, mech) -> None:
+    """The values of the metadata lines zerocal reads, each of the right form (DataFileError naming the line)."""
+    from zerocal_sym.io.compensation import parse_offsets
+    from zerocal_sym.io.results import SHA256_RE
+
+    sha = meta.get("robot_sha256")
+    if sha is not None and not SHA256_RE.fullmatch(sha):
+        raise DataFileError(f"'# robot_sha256:' must be the robot's SHA-256, 64 hexadecimal digits ('zerocal robot' "
+                            f"prints it), got {sha[:80]!r}", where=f"{src}:{meta_lines['robot_sha256']}")
+    comp = meta.get("compensation_deg")
+    if comp is not None and parse_offsets(comp, mech.m) is None:
+        raise DataFileError(f"'# compensation_deg:' must be {mech.m} finite angles in deg, one per joint "
+                            f"({', '.join(mech.joint_names)}), got {comp[:80]!r}",
+                            where=f"{src}:{meta_lines['compensation_deg']}")
 
 
 def _declared_mechanism(meta, meta_lines, src, robot):
@@ -99,7 +118,7 @@ def check_against_robot(meas: Measurements, robot) -> None:
         raise DataFileError(f"{meas.m} joint and {meas.n or 0} target columns, the robot's mechanism "
                             f"{robot.mechanism_name} has {cols.example}", where=meas.source)
     sha = meas.meta.get("robot_sha256")
-    if sha and sha != robot.sha256:
+    if sha and sha.lower() != robot.sha256:
         line = meas.meta_lines.get("robot_sha256")
         raise DataFileError(
             f"measured on another robot: robot_sha256 {sha[:12]}... in the file, {robot.sha256[:12]}... for "

@@ -55,8 +55,8 @@ from zerocal_sym.io.csvtext import (MECHANISM_KEY, _check_header, _check_pose_nu
                                     _read_text, _rows_to_array, _split_csv, get_mechanism_of, infer_mechanism,
                                     mechanism_for_shape)
 from zerocal_sym.io.files import atomic_write_text
-from zerocal_sym.io.measurement_checks import (_check_columns_fit_robot, _check_duplicates, _declared_mechanism,
-                                               check_against_robot)
+from zerocal_sym.io.measurement_checks import (_check_columns_fit_robot, _check_duplicates, _check_metadata,
+                                               _declared_mechanism, check_against_robot)
 from zerocal_sym.io.measurement_columns import measurement_columns
 from zerocal_sym.model.measurements import Measurements, _check_arrays
 
@@ -228,6 +228,7 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
         mech = get_mechanism_of(declared)
     else:
         mech = infer_mechanism(rows[0][1]) if rows else get_mechanism_of(None)
+    _check_metadata(meta, meta_lines, src, mech)
     cols = measurement_columns(mech)
     if not rows:
         raise DataFileError(f"empty file: no header line and no data (expected the header {cols.example})",

@@ -8,17 +8,44 @@ mechanism: ``zero_offsets_deg`` (joint order, m values), ``std_zero_offsets_deg`
 parameters by name (``estimate``, ``std``, ``units``) and, when present, the
 ``mechanism``.  The compensation table made from it is
 :mod:`zerocal_sym.io.compensation`.
+
+Only ``zero_offsets_deg`` is required; every other key is optional, and
+``null`` for an optional key is the same as leaving it out.  Every key that
+is read is checked against the others, so a hand edit of one copy of a value
+is an error, not silently ignored: ``estimate`` and ``std`` against
+``zero_offsets_deg``, ``std_zero_offsets_deg`` and ``maemm_mm``; the
+``compensation`` block (``offset_deg``, ``std_deg``, ``joints``,
+``sign_convention``) against the same; ``units`` against the mechanism;
+``joint_names`` and ``pose_names`` against the mechanism; ``mechanism``
+against ``robot.mechanism``; the robot hashes (``robot_sha256``,
+``robot.sha256``, ``robot_hash``: 64 hexadecimal digits each) against each
+other.  Standard deviations are >= 0 or null.
 """
 from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.io.csvtext import _json_line, _load_json, _read_text, get_mechanism_of, mechanism_for_shape
+
+#: the sign convention of every file that carries offsets (a results file's ``compensation.sign_convention``)
+SIGN_CONVENTION = "theta_cmd = IK(P) - offset_deg (actual joint angle = commanded + offset)"
+#: the unit of the zero offsets at the file edge: every key that names them is made from it here
+OFFSET_UNIT = "deg"
+OFFSETS_KEY = f"zero_offsets_{OFFSET_UNIT}"
+STD_OFFSETS_KEY = f"std_{OFFSETS_KEY}"
+#: the offsets and their standard deviations in the ``compensation`` block
+COMPENSATION_KEYS = (f"offset_{OFFSET_UNIT}", f"std_{OFFSET_UNIT}")
+MAEMM_KEY = "maemm_mm"
+#: two copies of one value (a key and ``estimate``, ``compensation``) agree within this (relative and absolute)
+SAME_VALUE_TOL = 1e-9
+#: a robot hash: what ``zerocal robot`` prints (SHA-256, hexadecimal)
+SHA256_RE = re.compile(r"[0-9a-fA-F]{64}")
 
 
 @dataclass
@@ -94,13 +121,17 @@ def _where(text, key, src):
     return f"{src}:{line}" if line else src
 
 
-def _vector(obj, key, names, text, src, required=True):
-    """The list ``obj[key]`` of ``len(names)`` numbers (nulls allowed unless required), ndarray."""
+def _vector(obj, key, names, text, src, required=True, std=False):
+    """The list ``obj[key]`` of ``len(names)`` numbers (nulls allowed unless required; ``std``: >= 0), ndarray.
+
+    An optional key that is missing or ``null`` is all NaN.
+    """
     where = _where(text, key, src)
     k = len(names)
-    if key not in obj:
+    if obj.get(key) is None:
         if required:
-            raise DataFileError(f"missing key '{key}' (a results file from 'zerocal identify --json')", where=src)
+            raise DataFileError(f"missing key '{key}' (a results file from 'zerocal identify --json')",
+                                where=where if key in obj else src)
         return np.full(k, np.nan)
     v = obj[key]
     if not isinstance(v, list) or len(v) != k:
@@ -114,38 +145,64 @@ def _vector(obj, key, names, text, src, required=True):
         if not _finite_number(x):
             raise DataFileError(f"key '{key}' must be a list of {k} finite numbers, got {json.dumps(v)[:60]}",
                                 where=where)
+        if std and x < 0:
+            raise DataFileError(f"key '{key}': a standard deviation must be >= 0 (or null if unknown), got "
+                                f"{json.dumps(v)[:60]}", where=where)
         out.append(float(x))
     return np.array(out)
 
 
-def _find_sha(obj):
-    for k in ("robot_sha256", "robot_hash"):
-        if isinstance(obj.get(k), str):
-            return obj[k]
+def _robot_block(obj, text, src) -> dict:
+    """The ``robot`` object ({} if missing or null)."""
     r = obj.get("robot")
-    if isinstance(r, dict) and isinstance(r.get("sha256"), str):
-        return r["sha256"]
-    return None
+    if r is None:
+        return {}
+    if not isinstance(r, dict):
+        raise DataFileError("key 'robot' must be an object {name, source, sha256, mechanism}",
+                            where=_where(text, "robot", src))
+    return r
+
+
+def _find_sha(obj, text, src):
+    """The robot hash: ``robot_sha256``, ``robot.sha256``, ``robot_hash``, each 64 hex digits, all the same; or None."""
+    found = []
+    for key, v in (("robot_sha256", obj.get("robot_sha256")), ("sha256", _robot_block(obj, text, src).get("sha256")),
+                   ("robot_hash", obj.get("robot_hash"))):
+        if v is None:
+            continue
+        label = "robot.sha256" if key == "sha256" else key
+        if not isinstance(v, str) or not SHA256_RE.fullmatch(v):
+            raise DataFileError(f"key '{label}' must be the robot's SHA-256, 64 hexadecimal digits ('zerocal robot' "
+                                f"prints it), got {json.dumps(v)[:80]}", where=_where(text, key, src))
+        found.append((label, v.lower(), key))
+    for label, v, key in found[1:]:
+        if v != found[0][1]:
+            raise DataFileError(f"key '{label}' ({v[:12]}...) and '{found[0][0]}' ({found[0][1][:12]}...) name "
+                                "different robots: one result is of one robot", where=_where(text, key, src))
+    return found[0][1] if found else None
 
 
 def _find_mechanism(obj, text, src):
-    """The ``mechanism`` key (or ``robot.mechanism``), checked; None without."""
+    """The ``mechanism`` key (and ``robot.mechanism``, which must agree), checked; None without."""
     from zerocal_sym.model.mechanism import REGISTRY
 
-    v = obj.get("mechanism")
-    if v is None and isinstance(obj.get("robot"), dict):
-        v = obj["robot"].get("mechanism")
-    if v is None:
-        return None
-    if not isinstance(v, str) or v not in REGISTRY:
-        raise DataFileError(f"unknown mechanism {json.dumps(v)[:60]} (known: {', '.join(REGISTRY)})",
-                            where=_where(text, "mechanism", src))
-    return v
+    named = [(k, v) for k, v in (("mechanism", obj.get("mechanism")),
+                                 ("robot.mechanism", _robot_block(obj, text, src).get("mechanism"))) if v is not None]
+    for k, v in named:
+        if not isinstance(v, str) or v not in REGISTRY:
+            raise DataFileError(f"key '{k}': unknown mechanism {json.dumps(v)[:60]} (known: {', '.join(REGISTRY)})",
+                                where=_where(text, "mechanism", src))
+    if len(named) == 2 and named[0][1] != named[1][1]:
+        raise DataFileError(f"key 'mechanism' is {named[0][1]}, 'robot.mechanism' is {named[1][1]}: one result is of "
+                            "one mechanism", where=_where(text, "mechanism", src))
+    return named[0][1] if named else None
 
 
 def _by_name(obj, key, mech, text, src, kind):
-    """``obj[key]``: {name: number (or null for std) | unit string}, names of ``mech`` if known."""
-    v = obj.get(key, {})
+    """``obj[key]``: {name: number (or null for std, >= 0) | unit string}, names of ``mech`` if known ({} if null)."""
+    v = obj.get(key)
+    if v is None:
+        return {}
     where = _where(text, key, src)
     if not isinstance(v, dict):
         raise DataFileError(f"key '{key}' must be an object {{parameter name: value}}", where=where)
@@ -155,9 +212,11 @@ def _by_name(obj, key, mech, text, src, kind):
             raise DataFileError(f"key '{key}': unknown parameter {name!r} of mechanism {mech.name} (known: "
                                 f"{', '.join(mech.errors.names)})", where=where)
         if kind == "unit":
-            if x not in ("deg", "mm"):
-                raise DataFileError(f"key '{key}': the unit of {name!r} must be \"deg\" or \"mm\", got "
-                                    f"{json.dumps(x)[:30]}", where=where)
+            want = (mech.errors[name].user_unit,) if mech is not None else ("deg", "mm")
+            if x not in want:
+                raise DataFileError(f"key '{key}': the unit of {name!r} must be "
+                                    f"{' or '.join(json.dumps(w) for w in want)}, got {json.dumps(x)[:30]}",
+                                    where=where)
             out[name] = x
             continue
         if x is None and kind == "std":
@@ -166,8 +225,65 @@ def _by_name(obj, key, mech, text, src, kind):
         if not _finite_number(x):
             raise DataFileError(f"key '{key}': {name!r} must be a finite number, got {json.dumps(x)[:30]}",
                                 where=where)
+        if kind == "std" and x < 0:
+            raise DataFileError(f"key '{key}': the standard deviation of {name!r} must be >= 0 (or null if "
+                                f"unknown), got {json.dumps(x)[:30]}", where=where)
         out[name] = float(x)
     return out
+
+
+def _merge(copy_key, copy: dict, key, names, values, text, src) -> np.ndarray:
+    """``values`` (for ``names``) with the other copy ``copy`` ({name: value}) merged in.
+
+    Where both copies give a number they must agree (within
+    :data:`SAME_VALUE_TOL`): the error names both keys.  Where only one does
+    (the other missing or null), that number is the value.
+    """
+    out = np.array(values, float)
+    for j, name in enumerate(names):
+        c = copy.get(name, math.nan)
+        if math.isnan(c):
+            continue
+        if math.isnan(out[j]):
+            out[j] = c
+        elif not math.isclose(c, out[j], rel_tol=SAME_VALUE_TOL, abs_tol=SAME_VALUE_TOL):
+            raise DataFileError(f"key '{copy_key}': {name} = {float(c)!r} disagrees with '{key}' ({float(out[j])!r}): "
+                                "one of the two copies was edited; make them the same",
+                                where=_where(text, copy_key, src))
+    return out
+
+
+def _check_names(obj, key, want, text, src) -> None:
+    v = obj.get(key)
+    if v is not None and v != list(want):
+        raise DataFileError(f"key '{key}' must be {json.dumps(list(want))} (the mechanism's), got {json.dumps(v)[:80]}",
+                            where=_where(text, key, src))
+
+
+def _compensation(obj, names, off, std, joints, text, src) -> np.ndarray:
+    """The ``compensation`` block, if any: the same offsets, std, joints and sign convention as the rest.
+
+    Returns ``std`` with the block's ``std_deg`` merged in (:func:`_merge`).
+    """
+    c = obj.get("compensation")
+    if c is None:
+        return std
+    where = _where(text, "compensation", src)
+    if not isinstance(c, dict):
+        raise DataFileError("key 'compensation' must be an object {sign_convention, joints, offset_deg, std_deg}",
+                            where=where)
+    sign = c.get("sign_convention")
+    if sign is not None and sign != SIGN_CONVENTION:
+        raise DataFileError(f"key 'compensation': sign_convention {json.dumps(sign)[:80]} is not zerocal's "
+                            f"({SIGN_CONVENTION!r}): the offsets would be applied with the wrong sign",
+                            where=_where(text, "sign_convention", src))
+    if joints is not None:
+        _check_names(c, "joints", joints, text, src)
+    off_key, std_key = COMPENSATION_KEYS
+    comp_off = _vector(c, off_key, names, text, src, required=False)
+    comp_std = _vector(c, std_key, names, text, src, required=False, std=True)
+    _merge(off_key, dict(zip(names, comp_off)), OFFSETS_KEY, names, off, text, src)
+    return _merge(std_key, dict(zip(names, comp_std)), STD_OFFSETS_KEY, names, std, text, src)
 
 
 def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
@@ -214,11 +330,16 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
         off = obj.get("zero_offsets_deg")
         mech = mechanism_for_shape(m=len(off)) if isinstance(off, list) else None
     shape_of = mech or get_mechanism_of(None)  # the sizes expected when the mechanism is unknown
-    off = _vector(obj, "zero_offsets_deg", shape_of.errors.zero_offsets, text, src)
-    std = _vector(obj, "std_zero_offsets_deg", shape_of.errors.zero_offsets, text, src, required=False)
-    maemm = _vector(obj, "maemm_mm", shape_of.errors.measuring, text, src, required=False)
+    names, measuring = shape_of.errors.zero_offsets, shape_of.errors.measuring
+    off = _vector(obj, OFFSETS_KEY, names, text, src)
+    std = _vector(obj, STD_OFFSETS_KEY, names, text, src, required=False, std=True)
+    maemm = _vector(obj, MAEMM_KEY, measuring, text, src, required=False)
     success = obj.get("success", True)
-    status = str(obj.get("status", ""))
+    for key in ("status", "method"):
+        if obj.get(key) is not None and not isinstance(obj[key], str):
+            raise DataFileError(f"key '{key}' must be a string, got {json.dumps(obj[key])[:60]}",
+                                where=_where(text, key, src))
+    status = obj.get("status") or ""
     if not isinstance(success, bool):
         raise DataFileError("key 'success' must be true or false", where=_where(text, "success", src))
     if not success and not allow_failed:
@@ -227,5 +348,12 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     estimate = _by_name(obj, "estimate", mech, text, src, "value")
     stds = _by_name(obj, "std", mech, text, src, "std")
     units = _by_name(obj, "units", mech, text, src, "unit")
-    return ResultFile(off, std, maemm, str(obj.get("method", "?")), status, success, _find_sha(obj), obj, src,
+    off = _merge("estimate", estimate, OFFSETS_KEY, names, off, text, src)
+    std = _merge("std", stds, STD_OFFSETS_KEY, names, std, text, src)
+    maemm = _merge("estimate", estimate, MAEMM_KEY, measuring, maemm, text, src)
+    if mech is not None:
+        _check_names(obj, "joint_names", mech.joint_names, text, src)
+        _check_names(obj, "pose_names", mech.pose_names, text, src)
+    std = _compensation(obj, names, off, std, None if mech is None else mech.joint_names, text, src)
+    return ResultFile(off, std, maemm, obj.get("method") or "?", status, success, _find_sha(obj, text, src), obj, src,
                       mechanism=None if mech is None else mech.name, estimate=estimate, std=stds, units=units)

@@ -292,11 +292,12 @@ def _check_keys(keys: dict, where) -> None:
 def read_toml(path, error, what: str) -> dict:
     """The TOML file at ``path`` as a dict; ``error(message, where=...)`` naming the file (and line) otherwise.
 
-    ``what`` names the file in the messages ("robot file", "study spec").
+    ``what`` names the file in the messages ("robot file", "study spec").  UTF-8; a
+    byte-order mark at the start is accepted (and skipped).
     """
     path = Path(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8").removeprefix("\ufeff")
     except FileNotFoundError:
         raise error(f"{what} not found", where=str(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
@@ -338,7 +339,7 @@ def load_robot(path) -> Robot:
     """
     path = Path(path)
     keys = read_toml(path, RobotFileError, "robot file")
-    text = path.read_text()  # for the line numbers of the keys
+    text = path.read_text(encoding="utf-8").removeprefix("\ufeff")  # for the line numbers of the keys
 
     def where(key):
         line = _line_of(text, key) if key else None
@@ -390,6 +391,12 @@ def validate(robot: Robot, where=None) -> dict:
         v = getattr(robot.workspace, key)
         if v <= 0:
             raise RobotFileError(f"workspace size {key} must be positive, got {v:g}", where=where(key))
+    for key in getattr(robot.workspace, "distances", ()):
+        v = getattr(robot.workspace, key)
+        if v <= 0:
+            raise RobotFileError(f"workspace distance {key} must be positive, got {v:g}: it is how far the workspace "
+                                 f"is from the base ({robot.workspace.kind}: {robot.workspace.describe()} mm), on "
+                                 "the side the mechanism works", where=where(key))
     if max(robot.param(k) for k in mech.positive) < 10:
         raise RobotFileError("link lengths look like metres: robot files are in mm", where=where(key_of(mech.positive[0])))
     if not 0 < robot.singularity_margin < 1:

@@ -33,6 +33,8 @@ class Rectangle:
     kind = "rectangle"
     keys = ("H", "b", "h")
     sizes = ("b", "h")
+    #: keys that are distances from the base, positive (the workspace is on the side the mechanism works)
+    distances = ("H",)
     n = 2
     scheme_name = "paper"
 
@@ -92,6 +94,8 @@ class Cylinder:
     kind = "cylinder"
     keys = ("rw", "H", "h")
     sizes = ("rw", "h")
+    #: keys that are distances from the base, positive (the workspace is below the base)
+    distances = ("H",)
     n = 3
     scheme_name = "ring"
 
