@@ -187,5 +187,6 @@ def apply(result, fit: dict, accept_misfit: bool = False):
             result.status = (f"rejected: the noise model rejects the fit ({_summary(fit)})"
                              if math.isfinite(fit["chi2"]) else
                              "rejected: the exact model cannot be evaluated at the estimate (a pose is not an "
-                             "assembly of the robot with those errors)")
+                             "assembly of the robot with those errors" + (f"; likely: {det[0]['text']})" if det
+                                                                         else ")"))
     return result
