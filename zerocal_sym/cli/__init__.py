@@ -8,9 +8,11 @@ that defines ``NAME``, ``HELP``, ``add_arguments(parser)`` and ``run(args)``
 Exit status: 0 success, 1 a check that failed (``regen --check``), 2 a user
 error (bad file, bad pose, bad option, an option that does not apply to the
 chosen mode, an output that is an input): one line on stderr, no traceback,
-no output file written; 130 interrupted (Ctrl-C), nothing written; 141 the
-reader of the standard output went away (``zerocal ... | head -1``): quietly,
-as a program killed by SIGPIPE.
+no output file written; 130 interrupted (Ctrl-C), 143 terminated (SIGTERM):
+stopped, cleaned up, nothing written; 141 the reader of the standard output
+went away (``zerocal ... | head -1``): quietly, as a program killed by
+SIGPIPE.  A Ctrl-C or SIGTERM that arrives once the command has written its
+outputs does not change its status (:mod:`zerocal_sym.cli._interrupt`).
 """
 from __future__ import annotations
 
@@ -18,7 +20,6 @@ import argparse
 import importlib
 import os
 import pkgutil
-import signal
 import sys
 
 from zerocal_sym.errors import ZerocalError
@@ -111,6 +112,9 @@ def _given_options(argv) -> set:
 
 
 def main(argv=None) -> int:
+    from zerocal_sym.cli import _interrupt
+
+    _interrupt.reset()
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
@@ -124,8 +128,8 @@ def main(argv=None) -> int:
 
         args._given = _given_options(argv)
         check_args(args)  # options of the mode, numbers, outputs vs inputs: before any work
-        with installed():  # Ctrl-C that a solver swallows is raised again (cli/_interrupt.py)
-            status = int(args._run(args) or 0)
+        with installed() as guard:  # Ctrl-C that a solver swallows is raised again (cli/_interrupt.py)
+            status = int(guard.call(args._run, args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at exit
         return status
     except ZerocalError as exc:
@@ -155,13 +159,15 @@ _CONSOLE = False
 
 
 def _interrupted(args) -> int:
+    from zerocal_sym.cli._interrupt import ignore_signals, interrupt_status
     from zerocal_sym.model.compiled import stop_builds
 
     if _CONSOLE:  # the process ends with 130: a burst of Ctrl-C (GNU timeout signals twice) must not cut that short
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        ignore_signals()
     stop_builds()  # a compiler building in the background stops too (zerocal_sym.model.compiled)
-    print(f"zerocal {args.command}: interrupted", file=sys.stderr)
-    return 130
+    status, word = interrupt_status()  # 130 interrupted (Ctrl-C), 143 terminated (SIGTERM)
+    print(f"zerocal {args.command}: {word}", file=sys.stderr)
+    return status
 
 
 def _from_interrupt(exc) -> bool:
@@ -182,24 +188,36 @@ def _stdout_closed() -> int:
     return EXIT_BROKEN_PIPE
 
 
-def entry() -> None:  # console script
+def entry(held=()) -> None:
+    """The ``zerocal`` console script (through :func:`zerocal_sym.__main__.console`).
+
+    ``held``: the signals (SIGINT, SIGTERM) that arrived while the CLI was imported (they were held then).
+    """
     global _CONSOLE
     _CONSOLE = True
+    from zerocal_sym.cli import _interrupt
+
     try:
+        _interrupt.install_startup_handlers()  # from here until the command's own: KeyboardInterrupt
+        for signum in held:  # a Ctrl-C or SIGTERM while importing: acted on now, as any other
+            _interrupt.note(signum)
+        if held:
+            raise KeyboardInterrupt
         status = main()
     except KeyboardInterrupt:  # before a command ran (while parsing, importing)
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        print("zerocal: interrupted", file=sys.stderr)
-        status = 130
+        _interrupt.ignore_signals()
+        status, word = _interrupt.interrupt_status()
+        print(f"zerocal: {word}", file=sys.stderr)
     except BrokenPipeError:
         status = _stdout_closed()
-    if status == 130:
-        _exit_interrupted()
+    _interrupt.ignore_signals()  # the command is over: a late signal does not change its status
+    if status in _interrupt.EXIT_STATUS.values():
+        _exit_interrupted(status)
     sys.exit(status)
 
 
-def _exit_interrupted() -> None:
-    """End with status 130 after Ctrl-C, cleanly, whatever CPython noted.
+def _exit_interrupted(status: int = 130) -> None:
+    """End with ``status`` (130, 143) after Ctrl-C or SIGTERM, cleanly, whatever CPython noted.
 
     A Ctrl-C that lands inside ``exec`` of a string (dataclasses and
     namedtuples are made so) makes CPython note the interrupt as unhandled,
@@ -218,4 +236,4 @@ def _exit_interrupted() -> None:
             stream.flush()
         except (OSError, ValueError, AttributeError):
             pass
-    os._exit(130)
+    os._exit(status)

@@ -236,6 +236,9 @@ def run(args, robot):
         design.plot_design(args.plot, robot, res)
         out["plot"] = str(args.plot)
     write_out(args, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0
@@ -405,6 +408,9 @@ def _run_target(args, robot):
     out[k("crlb_zero_offsets")] = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise).tolist()
     out = json_safe(out)
     write_out(args, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0

@@ -131,6 +131,9 @@ def run(args, robot):
         out["n_table"] = table
     out = json_safe(out)
     write_out(args, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0

@@ -16,6 +16,15 @@ propagates as usual.  Once the interrupt is
 being handled (the handler runs while a ``KeyboardInterrupt``, or an error
 made of one, is the exception being handled: a ``finally`` or ``except``
 cleaning up), it does nothing more, so cleanup code runs undisturbed.
+
+SIGTERM (``kill PID``, a job scheduler's stop) is handled the same way: the
+command stops, cleans up (worker processes, temporary files and directories)
+and exits with :data:`EXIT_STATUS` ``[SIGTERM]`` = 143 instead of 130
+(:func:`interrupt_status`).
+
+Once the command has written its outputs -- it called :func:`outputs_written`,
+or its ``run`` returned (:meth:`_Redeliver.call`) -- a Ctrl-C or SIGTERM no
+longer stops it: its outputs and exit status stand (it only reports).
 """
 from __future__ import annotations
 
@@ -26,6 +35,59 @@ import signal
 import sys
 import threading
 import time
+
+
+#: the signals that stop a command, and the exit status of each (128 + the signal's number)
+EXIT_STATUS = {signal.SIGINT: 130, signal.SIGTERM: 143}
+#: what the command says when it stops on each
+WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated"}
+
+_received: set = set()  # the signals of the current command (from its start)
+_active = None          # the _Redeliver of the command running (installed())
+
+
+def note(signum) -> None:
+    """Record that ``signum`` arrived (the exit status says which: :func:`interrupt_status`)."""
+    _received.add(signum)
+
+
+def reset() -> None:
+    """Forget the signals of an earlier command (a new one starts)."""
+    _received.clear()
+
+
+def interrupt_status() -> tuple:
+    """``(exit status, word)`` of a stopped command: SIGTERM's (143, "terminated") if one arrived, else
+    Ctrl-C's (130, "interrupted")."""
+    sig = signal.SIGTERM if signal.SIGTERM in _received else signal.SIGINT
+    return EXIT_STATUS[sig], WORDS[sig]
+
+
+def startup_handler(signum, frame):
+    """The handler while the CLI starts (parsing, imports): note the signal and stop (KeyboardInterrupt)."""
+    note(signum)
+    raise KeyboardInterrupt
+
+
+def install_startup_handlers() -> None:
+    """SIGINT and SIGTERM raise KeyboardInterrupt (noted) until :func:`installed` takes over."""
+    for sig in EXIT_STATUS:
+        signal.signal(sig, startup_handler)
+
+
+def ignore_signals() -> None:
+    """The command is over (done, or stopped and reported): a late Ctrl-C or SIGTERM does not change its status."""
+    for sig in EXIT_STATUS:
+        try:
+            signal.signal(sig, signal.SIG_IGN)
+        except (ValueError, OSError):  # not the main thread
+            pass
+
+
+def outputs_written() -> None:
+    """Called by a command once its outputs are in place: from here on it is not stopped by a signal."""
+    if _active is not None:
+        _active.done = True
 
 
 def is_interrupt(exc) -> bool:
@@ -57,6 +119,8 @@ class _Redeliver:
     def __init__(self):
         self.lock = threading.Lock()
         self.closed = False
+        self.done = False  # the command has written its outputs or returned: signals no longer stop it
+        self.signum = signal.SIGINT  # the signal to re-trip with (the last one received)
         self.ended = None  # why the thread ended: "closed" (woken by close()) or "eof" (the pipe closed on it)
         self._r, self._w = os.pipe()
         self.thread = threading.Thread(target=self._run, name="zerocal-ctrl-c", daemon=True)
@@ -79,7 +143,7 @@ class _Redeliver:
                 with self.lock:
                     if self.closed:
                         return
-                    _thread.interrupt_main()  # the main thread runs the handler at its next check
+                    _thread.interrupt_main(self.signum)  # the main thread runs the handler at its next check
         finally:
             os.close(self._r)
 
@@ -94,10 +158,21 @@ class _Redeliver:
             self._wake()
 
     def handler(self, signum, frame):
-        if is_interrupt(sys.exc_info()[1]):  # already on its way up: let the cleanup run
+        note(signum)
+        self.signum = signum
+        if self.done or is_interrupt(sys.exc_info()[1]):  # finished, or already on its way up: let it end
             return
         self._kick()  # pending again soon, in case C code swallows this one
+        if frame is not None and frame.f_code is _CALL_CODE:
+            return  # in call() itself, just before or just after the command: decided at the re-trip
         raise KeyboardInterrupt
+
+    def call(self, fn, *args):
+        """``fn(*args)`` (the command's ``run``); once it has returned, a signal no longer stops anything."""
+        try:
+            return fn(*args)
+        finally:
+            self.done = True
 
     def close(self):
         with self.lock:
@@ -114,23 +189,51 @@ def _noop(*args):
     return None
 
 
+_CALL_CODE = _Redeliver.call.__code__
+
+
+class _Plain:
+    """What :func:`installed` yields where it cannot install a handler: :meth:`call` only."""
+
+    done = False
+
+    def call(self, fn, *args):
+        return fn(*args)
+
+
 @contextlib.contextmanager
 def installed():
-    """The handler for the ``with`` block (main thread only; elsewhere a no-op)."""
+    """The handlers of SIGINT and SIGTERM for the ``with`` block (main thread only; elsewhere a no-op).
+
+    Yields the object whose ``call(run, args)`` runs the command (:meth:`_Redeliver.call`).
+    """
+    global _active
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield _Plain()
         return
     redeliver = _Redeliver()
+    previous = {}
     try:
-        previous = signal.signal(signal.SIGINT, redeliver.handler)
+        for sig in EXIT_STATUS:
+            previous[sig] = signal.signal(sig, redeliver.handler)
     except (ValueError, OSError):  # no signals here (an embedded interpreter)
+        _restore(previous)
         redeliver.close()
-        yield
+        yield _Plain()
         return
+    _active = redeliver
     try:
-        yield
+        yield redeliver
     finally:
-        signal.signal(signal.SIGINT, _noop)  # a re-trip still pending is taken here, not by the caller
+        _active = None
+        for sig in previous:
+            signal.signal(sig, _noop)  # a re-trip still pending is taken here, not by the caller
         redeliver.close()
         _noop()
-        signal.signal(signal.SIGINT, previous)
+        _restore(previous)
+
+
+def _restore(previous: dict) -> None:
+    for sig, handler in previous.items():
+        if handler is not None:  # (None: a handler not set from Python; it cannot be put back)
+            signal.signal(sig, handler)

@@ -131,6 +131,9 @@ def run(args):
     rep["settings"]["mechanism"] = robot.mechanism_name
     if args.out:
         write_json(args.out, rep)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     print(to_json(rep) if args.json else format_compare(rep))
     return 0
 

@@ -155,6 +155,9 @@ def run(args):
             atomic_write_text(args.out, text)
         except OSError as exc:
             raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=args.out) from None
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json({units.joint_key(robot, "zero_offsets"): [float(v) for v in offsets], "joints": list(joints),
                        "mechanism": robot.mechanism_name, "sign_convention": sign_convention(units.joint_unit(robot)),

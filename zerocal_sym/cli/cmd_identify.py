@@ -331,9 +331,10 @@ def run(args):
             raise ZerocalError("--max-iter must be >= 1")
         res = identify_nlls(robot, meas, names, noise=noise, prior=prior, bounds=bounds or None,
                             prior_std=pstd or None, max_iter=args.max_iter, **trust_kwargs(args, "nlls"))
-    report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=res.full_vector())
+    err0 = evaluation_point(robot, meas, res, prior)
+    report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=err0)
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
-    bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=res.full_vector())
+    bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=err0)
     out["bias"] = bias
     if not res.success:
         if args.json:
@@ -370,6 +371,9 @@ def run(args):
             identify_plots(plot_dir, res, meas, robot, err_true=truth_from_meta(meas, robot))
         if args.out:
             write_json(args.out, out)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(out))
         return 0
@@ -390,6 +394,22 @@ def run(args):
         print(f"wrote {args.out}")
     print(verdict_line(res, args))
     return 0
+
+
+def evaluation_point(robot, meas, res, prior):
+    """Where the identifiability report and the bias are evaluated: the estimate, or the prior when the
+    distance model is not finite at the estimate (a failed identification that ended where a pose is not an
+    assembly of the robot: the report of these poses is then the one at the prior)."""
+    import numpy as np
+
+    from zerocal_sym.model import kinematics as kin
+
+    err = res.full_vector()
+    if not np.all(np.isfinite(err)):
+        return prior
+    with np.errstate(all="ignore"):
+        rho, de, dt = kin.distance_jacobians(robot, meas.theta_cmd, err)
+    return err if all(np.all(np.isfinite(a)) for a in (rho, de, dt)) else prior
 
 
 def verdict_line(res, args) -> str:

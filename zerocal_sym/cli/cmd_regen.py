@@ -73,6 +73,9 @@ def run(args):
     from derivations.codegen import GENERATED_DIR, regen
 
     changed = regen(out_dir=args.out_dir, check=args.check)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     target = args.out_dir or GENERATED_DIR
     if args.check:
         if changed:

@@ -108,6 +108,9 @@ def run(args):
                     mu0_deg=args.mu0, max_iter=args.max_iter, identify=identify, progress=progress)
     if args.out:
         _write_out(args.out, rep, robot, args.n)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(rep))
     else:

@@ -141,6 +141,9 @@ def run(args):
     if args.group is not None:
         meas.meta["n"] = len(poses) // 2
     write_measurements(args.out, meas, mechanism=robot)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     print(f"wrote {meas.K} poses ({pose_what}; noise {args.noise}, seed {args.seed}) to {args.out}; true errors "
           f"{what}: {format_named(robot, err)} (robot frame)")
     return 0

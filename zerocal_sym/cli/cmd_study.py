@@ -153,5 +153,8 @@ def run(args):
                 b.close()
             err.end_line()  # interrupted inside a line: "zerocal study: interrupted" on its own
             _parallel.close(ex)
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     print(to_json(summary) if args.json else st.format_summary(summary))
     return 0

@@ -201,6 +201,9 @@ def run(args):
             target = args.plot
     except OSError as exc:
         raise ZerocalError(f"cannot write the output: {exc.strerror or exc}", where=exc.filename or target) from None
+    from zerocal_sym.cli._interrupt import outputs_written
+
+    outputs_written()  # from here on it only reports: a Ctrl-C or SIGTERM does not change its status
     if args.json:
         print(to_json(json_safe(out)))
     else:

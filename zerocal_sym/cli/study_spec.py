@@ -59,6 +59,12 @@ DESIGN_KEYS = ("scheme", "n", "poses", "robots", "label")
 TRUTH_RESERVED = ("name", "robots")
 NAMED_NOISE = ("paper", "scale-only", "servo-only", "none")
 DEFAULT_CHUNK = 10000
+#: the most trials per chunk file (the chunk's arrays are held in memory: 10^6 trials x p values)
+MAX_CHUNK = 1_000_000
+#: the most chunk files per cell (ceil(trials / chunk); the chunk list is built before the run)
+MAX_CHUNKS_PER_CELL = 1_000_000
+#: the largest factor of the paper's noise (x 1000: a servo error of 2.4 deg per joint, 1.1 mm per reading)
+MAX_NOISE_FACTOR = 1000.0
 CELL_FORMAT = "zerocal study cell v1"
 
 
@@ -183,7 +189,12 @@ def _is_int(v) -> bool:
 
 
 def _is_num(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(float(v))
+    if not isinstance(v, (int, float)) or isinstance(v, bool):
+        return False
+    try:
+        return math.isfinite(float(v))
+    except OverflowError:  # an integer beyond any float
+        return False
 
 
 def _noise_levels(raw, where):
@@ -200,19 +211,21 @@ def _noise_levels(raw, where):
                                      "of the paper's noise)", where=where("noise"))
             out.append((v, lambda robot, v=v: NoiseModel.named(v, robot)))
         elif _is_num(v):
-            if v < 0:
-                raise StudySpecError(f"noise factor {v!r} must be >= 0", where=where("noise"))
+            if not 0 <= v <= MAX_NOISE_FACTOR:
+                raise StudySpecError(f"noise factor {v!r} must be >= 0 and at most {MAX_NOISE_FACTOR:g} (times the "
+                                     "robot's default noise)", where=where("noise"))
             out.append((f"x{float(v):g}", lambda robot, f=float(v): robot.noise.scaled(f, f)))
         elif isinstance(v, dict):
             bad = [k for k in v if k not in ("scale", "servo")]
             vals = [v.get("scale", 1.0), v.get("servo", 1.0)]
-            if bad or not all(_is_num(x) and x >= 0 for x in vals):
-                raise StudySpecError(f"noise table {v!r}: keys scale and servo, factors >= 0 of the paper's "
-                                     "two noise terms", where=where("noise"))
+            if bad or not all(_is_num(x) and 0 <= x <= MAX_NOISE_FACTOR for x in vals):
+                raise StudySpecError(f"noise table {v!r}: keys scale and servo, factors >= 0 (at most "
+                                     f"{MAX_NOISE_FACTOR:g}) of the robot's two noise terms", where=where("noise"))
             out.append((f"scale{float(vals[0]):g}-servo{float(vals[1]):g}",
                         lambda robot, a=float(vals[0]), b=float(vals[1]): robot.noise.scaled(a, b)))
         else:
-            raise StudySpecError(f"noise level {v!r}: a name or a number", where=where("noise"))
+            shown = f"an integer of {len(str(abs(v)))} digits" if isinstance(v, int) and abs(v) >= 10**30 else repr(v)
+            raise StudySpecError(f"noise level {shown}: a name or a finite number", where=where("noise"))
     labels = [lab for lab, _ in out]
     dup = sorted({lab for lab in labels if labels.count(lab) > 1})
     if dup:
@@ -279,6 +292,16 @@ def _design_poses(tab, robot, base, wk):
     return tab.get("label") or f"{scheme}{n}", P
 
 
+def _first_unassembled(robot, theta, err):
+    """The first pose (index) where the exact distance model with the errors ``err`` is not finite, or None."""
+    from zerocal_sym.model import kinematics as kin
+
+    with np.errstate(all="ignore"):
+        rho, de, dt = kin.distance_jacobians(robot, theta, err)
+    bad = ~(np.isfinite(rho) & np.all(np.isfinite(de), axis=1) & np.all(np.isfinite(dt), axis=1))
+    return int(np.flatnonzero(bad)[0]) if bad.any() else None
+
+
 def load_spec(path) -> Study:
     """Read and validate a study spec (TOML); every cell is built (robots loaded, poses checked).
 
@@ -287,10 +310,10 @@ def load_spec(path) -> Study:
     StudySpecError
         Naming the spec file and the line.
     """
-    from zerocal_sym.cli._checks import identifiability_problem
+    from zerocal_sym.cli._checks import MAX_N, identifiability_problem
     from zerocal_sym.identify.montecarlo import offsets_missing
     from zerocal_sym.cli._common import parse_named_values
-    from zerocal_sym.identify.fitcheck import DEFAULT_MAX_OFFSET_DEG
+    from zerocal_sym.identify.fitcheck import DEFAULT_MAX_MAEMM_MM, DEFAULT_MAX_OFFSET_DEG
     from zerocal_sym.model import kinematics as kin
 
     from zerocal_sym.model.robot import read_toml
@@ -311,8 +334,13 @@ def load_spec(path) -> Study:
     if not _is_int(seed) or seed < 0:
         raise StudySpecError(f"seed must be a non-negative integer, got {seed!r}", where=where("seed"))
     chunk = raw.get("chunk", min(DEFAULT_CHUNK, trials))
-    if not _is_int(chunk) or chunk < 1:
-        raise StudySpecError(f"chunk must be a positive integer, got {chunk!r}", where=where("chunk"))
+    if not _is_int(chunk) or not 1 <= chunk <= MAX_CHUNK:
+        raise StudySpecError(f"chunk must be a positive integer of at most {MAX_CHUNK} (trials per chunk file), "
+                             f"got {chunk!r}", where=where("chunk"))
+    if -(-trials // chunk) > MAX_CHUNKS_PER_CELL:
+        raise StudySpecError(f"trials = {trials} in chunks of {chunk} make {-(-trials // chunk)} chunk files per cell: "
+                             f"at most {MAX_CHUNKS_PER_CELL} (give a larger chunk, or fewer trials)",
+                             where=where("chunk" if "chunk" in raw else "trials"))
     params = raw.get("params", "paper")
     if not isinstance(params, str):
         raise StudySpecError("params must be a string (paper | all | names joined by , or +)", where=where("params"))
@@ -352,13 +380,12 @@ def load_spec(path) -> Study:
             if "poses" in dt and ("scheme" in dt or "n" in dt):
                 raise StudySpecError("give poses = FILE or scheme/n, not both", where=wd("poses"))
             for k, ok in (("poses", lambda v: isinstance(v, str)), ("scheme", lambda v: isinstance(v, str)),
-                          ("label", lambda v: isinstance(v, str) and v), ("n", lambda v: _is_int(v) and v >= 2)):
+                          ("label", lambda v: isinstance(v, str) and v),
+                          ("n", lambda v: _is_int(v) and 2 <= v <= MAX_N)):
                 if k in dt and not ok(dt[k]):
                     raise StudySpecError(f"{k} = {dt[k]!r}: expected "
-                                         + ("an integer >= 2" if k == "n" else "a string"), where=wd(k))
-            if dt.get("n", 0) > MAX_N:  # as --n: before any pose is made
-                raise StudySpecError(f"n = {dt['n']}: at most {MAX_N} poses per boundary (K = 2n = {2 * MAX_N} "
-                                     "poses), as zerocal's --n", where=wd("n"))
+                                         + (f"an integer >= 2 and <= {MAX_N} (poses per boundary)" if k == "n" else
+                                            "a string"), where=wd(k))
             flt = _filter(dt, labels, wd)
             if flt is not None and rl not in flt:
                 continue
@@ -400,6 +427,16 @@ def load_spec(path) -> Study:
                     bad = next((k for k in values if k not in robot.errors.names), None)
                     raise StudySpecError(f"robot {rl!r}: {exc.message}", where=wt(bad)) from None
                 truth = robot.errors.from_user(user)
+                measuring = [k for k in robot.errors.measuring if k in values]
+                if measuring and math.hypot(*(float(values[k]) for k in measuring)) > DEFAULT_MAX_MAEMM_MM:
+                    raise StudySpecError(f"MAEMM {', '.join(f'{k} = {values[k]!r}' for k in measuring)} mm: beyond "
+                                         f"the plausible |rM| <= {DEFAULT_MAX_MAEMM_MM:g} mm (the identification's "
+                                         "plausibility limit)", where=wt(measuring[0]))
+                out = _first_unassembled(robot, theta, truth)
+                if out is not None:
+                    raise StudySpecError(f"robot {rl!r}, design {dlabel}: with these true errors pose {out} is not an "
+                                         "assembly of the robot (its measured distance is not finite): errors this "
+                                         "large are not a calibration's", where=wt(None))
                 problem = identifiability_problem(robot, theta, names, err0=truth)
                 if problem:
                     raise StudySpecError(f"robot {rl!r}, design {dlabel}: params = {params!r}: {problem}",

@@ -146,6 +146,8 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
             val = float(v)
         except (TypeError, ValueError):
             raise ZerocalError(f"tolerance {k}={v!r}: not a number") from None
+        except OverflowError:  # an integer beyond any float
+            raise ZerocalError(f"tolerance {k}: an integer of {len(str(v))} digits: must be finite") from None
         if not math.isfinite(val) or val < 0:
             raise ZerocalError(f"tolerance {k}={v!r}: must be finite and >= 0")
         tol[k] = errors.from_user_value(k, val)
@@ -155,6 +157,14 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
         raise ZerocalError(f"tolerance scale {scale!r}: not a number") from None
     if not math.isfinite(scale) or scale < 0:
         raise ZerocalError(f"tolerance scale must be finite and >= 0, got {scale!r}")
+    from zerocal_sym.model.robot import ANGLE_LIMIT_DEG, LENGTH_LIMIT_MM
+
+    for n in names:  # (the robot file's limits: a tolerance beyond is no manufacturing error, and overflows)
+        unit = errors[n].user_unit
+        limit = ANGLE_LIMIT_DEG if unit == "deg" else LENGTH_LIMIT_MM
+        if errors.to_user_value(n, tol[n]) * scale > limit:
+            raise ZerocalError(f"tolerance {n} = {errors.to_user_value(n, tol[n]) * scale:g} {unit}"
+                               + (f" (x {scale:g})" if scale != 1 else "") + f": beyond {limit:g} {unit}")
     return Tolerances({n: tol[n] * scale for n in names}, bias_model)
 
 
@@ -175,6 +185,8 @@ def _read_file(path) -> dict:
         data = json.loads(text) if p.suffix.lower() == ".json" else tomllib.loads(text)
     except (ValueError, tomllib.TOMLDecodeError) as exc:
         raise ZerocalError(f"bad tolerance file: {exc}", where=str(path)) from None
+    except RecursionError:  # arrays nested thousands deep
+        raise ZerocalError("bad tolerance file: arrays or tables nested too deeply", where=str(path)) from None
     if not isinstance(data, dict) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                              for v in data.values()):
         raise ZerocalError("a tolerance file holds name = value pairs (mm; deg for angles)", where=str(path))

@@ -145,6 +145,9 @@ def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
     head = (f"The noise model rejects this fit: chi2 = {chi2:.4g} on {dof} degrees of freedom "
             f"({_fmt_p(fit['p_value'])}, below {alpha:g}); the residuals are about {math.sqrt(ratio):.3g} times "
             "the noise the noise model states.")
+    if not math.isfinite(chi2):  # no residuals to test: the model is not finite at the estimate
+        head = ("The fit is rejected: the exact model cannot be evaluated at the estimate (a pose is not an "
+                "assembly of the robot with those errors), so the data do not fit this robot anywhere near it.")
     if detected:
         c = detected[0]
         body = f" Likely cause (detected): {c['text']}: {c['evidence']}."
@@ -163,9 +166,12 @@ def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
             parts.append(f"more than one bad reading (the largest standardised residual, {w['standardised']:+.3g} "
                          f"at pose {w['pose']}, does not explain the misfit alone)")
     parts.append("a wrong robot file (a geometry that is not this robot's leaves a systematic misfit)")
-    parts.append(f"a noise model that understates the noise (by about {math.sqrt(ratio):.3g} x in standard "
-                 "deviation; scale error {:.3g} um, servo error {:.3g} deg per joint as given)".format(
-                     fit["noise"]["sigma_scale_mm"] * 1e3, math.degrees(fit["noise"]["sigma_servo_rad"])))
+    if math.isfinite(ratio):
+        parts.append(f"a noise model that understates the noise (by about {math.sqrt(ratio):.3g} x in standard "
+                     "deviation; scale error {:.3g} um, servo error {:.3g} deg per joint as given)".format(
+                         fit["noise"]["sigma_scale_mm"] * 1e3, math.degrees(fit["noise"]["sigma_servo_rad"])))
+    else:
+        parts.append("readings that are not this round's (shuffled or edited rows, another robot's data)")
     if fit.get("active_bounds") or (exact is not None and np.any(exact.w)):
         parts.insert(0, "the bounds or the prior given (they hold the estimate where the data do not agree; the "
                         "fit without them does not pass either)")
@@ -212,10 +218,14 @@ def apply(result, fit: dict, accept_misfit: bool = False):
     if not result.success and det:  # a failed identification: say what the data look like
         result.status += f"; the data look wrong: {det[0]['text']} ({det[0]['evidence']})"
     if fit["rejected"] and result.success:
-        if accept_misfit:
+        if accept_misfit and math.isfinite(fit["chi2"]):  # (not when the model cannot be evaluated at all)
             fit["accepted_despite_misfit"] = True
             result.status = f"accepted despite misfit ({_summary(fit)}); {result.status}"
         else:
             result.success = False
-            result.status = f"rejected: the noise model rejects the fit ({_summary(fit)})"
+            result.status = (f"rejected: the noise model rejects the fit ({_summary(fit)})"
+                             if math.isfinite(fit["chi2"]) else
+                             "rejected: the exact model cannot be evaluated at the estimate (a pose is not an "
+                             "assembly of the robot with those errors" + (f"; likely: {det[0]['text']})" if det
+                                                                         else ")"))
     return result

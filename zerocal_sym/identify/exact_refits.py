@@ -94,6 +94,8 @@ class _Exact:
             r, rp, J, *_ = self.evaluate(z)
             rr = np.concatenate([r, rp[rows]])
             JJ = np.vstack([J[:K1], J[K1:][rows]]) @ basis
+            if not (np.all(np.isfinite(rr)) and np.all(np.isfinite(JJ))):  # (LAPACK would print to stdout on it)
+                raise FloatingPointError("the exact model is not finite at the refinement's point")
             step = basis @ np.linalg.lstsq(JJ, -rr, rcond=None)[0]
             if not np.all(np.isfinite(step)):
                 raise FloatingPointError("exact-model refinement diverged")
@@ -118,6 +120,8 @@ class _Exact:
         chi2 = float(r @ r + rp[rows] @ rp[rows])
         J = np.array(out[4])
         JJ = np.vstack([J[: K - 1], J[K - 1:][rows]])
+        if not (np.isfinite(chi2) and np.all(np.isfinite(JJ))):  # no fit: the model is not finite there
+            return float("inf"), (K - 1) + len(rows) - self.p   # (and LAPACK would print to stdout on it)
         sv = np.linalg.svd(JJ, compute_uv=False)
         rank = int(np.sum(sv > RANK_RTOL * sv[0])) if sv.size and sv[0] > 0 else 0
         dof = (K - 1) + len(rows) - rank

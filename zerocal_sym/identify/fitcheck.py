@@ -67,6 +67,8 @@ the pieces are importable from here too.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 # the pieces of the fit check, kept importable from here (callers, and the names the docstrings use)
@@ -302,8 +304,9 @@ def plausibility(robot, result, max_offset: float | None = None,
         if params is not None and n in params and not np.isfinite(s):
             reasons.append(f"the standard deviation of zero offset {n} is not finite (not identifiable)")
     mm = np.asarray(result.maemm_mm, float)
-    if mm.size and np.all(np.isfinite(mm)) and float(np.linalg.norm(mm)) > max_maemm_mm:
-        reasons.append(f"MAEMM |rM| = {np.linalg.norm(mm):.4g} mm is beyond the plausible {max_maemm_mm:g} mm "
+    norm = math.hypot(*mm.tolist()) if mm.size and np.all(np.isfinite(mm)) else None  # (no overflow: 1e308 mm)
+    if norm is not None and norm > max_maemm_mm:
+        reasons.append(f"MAEMM |rM| = {norm:.4g} mm is beyond the plausible {max_maemm_mm:g} mm "
                        "(the measuring mechanism's c / d in the robot file?)")
     elif mm.size and not np.all(np.isfinite(mm)) and params is not None:
         reasons.append("the MAEMM is not finite")

@@ -193,7 +193,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     r, rp, J, pred, l, b = sol.r, sol.rp, sol.J, sol.pred, sol.l, sol.b
     Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
     svd, sv, rank, cov, nonid, offsets_ok = information(J, Jd, r, K, has_prior, noise, scale, names, errors)
-    success = sol.converged and offsets_ok
+    success = sol.converged and offsets_ok and svd is not None  # (None: the model is not finite at sol.z)
     info = {
         "solver_status": sol.ret,
         "iterations": sol.iterations,

@@ -105,8 +105,16 @@ def information(J, Jd, r, K, has_prior, noise, scale, names, errors):
     Returns ``svd`` (J's), ``sv`` (singular values of the data part ``Jd``),
     ``rank``, ``cov`` (p, p; physical units, ``inf``/NaN on non-identifiable
     parameters), ``nonid`` (the null-space directions by name) and whether
-    every zero offset estimated is identifiable.
+    every zero offset estimated is identifiable.  A ``J`` that is not finite
+    (the exact model cannot be evaluated at the point: a pose is not an
+    assembly of the robot with those errors) carries no information: rank 0,
+    no SVD (None), the variances infinite.
     """
+    if not np.all(np.isfinite(J)):  # (LAPACK would fail on it, and print to stdout)
+        p = J.shape[1]
+        cov = np.full((p, p), np.nan)
+        np.fill_diagonal(cov, np.inf)
+        return None, np.zeros(0), 0, cov, [], not any(n in names for n in errors.zero_offsets)
     UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False)
     sF = sJ**2
     sv = (np.linalg.svd(Jd, compute_uv=False) if has_prior else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
@@ -139,7 +147,10 @@ def information(J, Jd, r, K, has_prior, noise, scale, names, errors):
 def status_line(sol, offsets_ok, rank, names, robust, loss) -> str:
     """The result's status line: Ipopt's verdict, identifiability, the robust loss's outliers."""
     ret = sol.ret
-    if not sol.converged:
+    if not (np.all(np.isfinite(sol.J)) and np.all(np.isfinite(sol.r))):
+        status = (f"the exact model cannot be evaluated where the solver stopped ({ret}): a pose is not an "
+                  "assembly of the robot with those errors")
+    elif not sol.converged:
         status = f"Ipopt did not converge: {ret}"
     elif not offsets_ok:
         status = (f"converged ({ret}) but the zero offsets are not identifiable from these poses "

@@ -102,6 +102,49 @@ def _worker_init():  # pragma: no cover - runs in the worker processes
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _die_with_parent()
+
+
+#: prctl's option that has the kernel signal a process when its parent ends (Linux, <sys/prctl.h>)
+PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent():  # pragma: no cover - runs in the worker processes
+    """End this worker when the process that started it ends, however it ends (SIGKILL included).
+
+    A worker waits for its next chunk on a pipe that it holds both ends of
+    (the ``spawn`` start method hands each worker the whole call queue), so
+    it never sees the parent go: after ``kill -9`` of the command, the
+    workers (and the resource tracker, which waits for everyone holding its
+    pipe) lived on.  On Linux the kernel sends this process SIGKILL when the
+    parent ends (``prctl(PR_SET_PDEATHSIG)``); elsewhere a thread waits on
+    the parent's sentinel (a pipe that closes when the parent ends) and
+    exits.  A parent that ended before this ran is noticed at once.
+    """
+    import multiprocessing
+    import os
+    import sys
+
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+    armed = False
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        except (OSError, AttributeError, TypeError):
+            armed = False
+    if os.getppid() != parent.pid:  # the parent is gone already (the signal only comes for a later end)
+        os._exit(1)
+    if not armed and parent.sentinel is not None:
+        def watch():
+            multiprocessing.connection.wait([parent.sentinel])
+            os._exit(1)
+
+        threading.Thread(target=watch, name="zerocal-parent-watch", daemon=True).start()
 
 
 @contextlib.contextmanager

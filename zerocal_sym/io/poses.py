@@ -30,8 +30,12 @@ def __getattr__(name):
 
 
 def _is_number(x) -> bool:
-    return (isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-            and abs(x) <= LENGTH_LIMIT_MM)
+    if not isinstance(x, (int, float)) or isinstance(x, bool):
+        return False
+    try:
+        return math.isfinite(x) and abs(x) <= LENGTH_LIMIT_MM
+    except OverflowError:  # an integer beyond any float
+        return False
 
 
 def load_poses(path, robot=None) -> np.ndarray:

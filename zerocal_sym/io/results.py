@@ -146,6 +146,16 @@ class ResultFile:
         return [f"theta{j + 1}" for j in range(self.m)]
 
 
+def _finite_number(x) -> bool:
+    """A JSON number that is a finite float (not a bool; an integer of 400 digits is not)."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return False
+    try:
+        return math.isfinite(x)
+    except OverflowError:  # an integer beyond any float
+        return False
+
+
 def _where(text, key, src):
     line = _json_line(text, key)
     return f"{src}:{line}" if line else src
@@ -172,7 +182,7 @@ def _vector(obj, key, names, text, src, required=True, std=False):
         if x is None and not required:
             out.append(np.nan)
             continue
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        if not _finite_number(x):
             raise DataFileError(f"key '{key}' must be a list of {k} finite numbers, got {json.dumps(v)[:60]}",
                                 where=where)
         if std and x < 0:
@@ -253,7 +263,7 @@ def _by_name(obj, key, mech, text, src, kind):
         if x is None and kind == "std":
             out[name] = float("nan")
             continue
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        if not _finite_number(x):
             raise DataFileError(f"key '{key}': {name!r} must be a finite number, got {json.dumps(x)[:30]}",
                                 where=where)
         if kind == "std" and x < 0:

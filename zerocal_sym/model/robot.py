@@ -62,6 +62,11 @@ DEFAULT_SINGULARITY_MARGIN = 0.2
 #: home joint values beyond this are a unit or typing error (file units; the data files' limits)
 HOME_LIMIT = {"deg": 3600.0, "mm": 1e5}
 HOME_LIMIT_DEG = HOME_LIMIT["deg"]
+#: a length (mm) in a robot file beyond this is no robot's (1 km, the data files' limit too; the distances'
+#: arithmetic overflows far beyond)
+LENGTH_LIMIT_MM = 1e6
+#: a geometric angle (deg) in a robot file beyond this is a unit or typing error
+ANGLE_LIMIT_DEG = 360.0
 TOP_KEYS = ("name", "mechanism", "mechanism_module", "units", "singularity_margin", "home")
 TABLES = ("geometry", "workspace", "noise")
 NOISE_KEYS = ("scale", "joint")
@@ -264,6 +269,10 @@ def _check_number(k, v, unit, where):
         raise RobotFileError(f"key '{k}' must be a number ({unit}), got {v!r}", where=where(k))
     if not _is_finite_number(v):
         raise RobotFileError(f"key '{k}' must be a finite number, got {_shown(v)}", where=where(k))
+    limit = ANGLE_LIMIT_DEG if unit == "deg" else LENGTH_LIMIT_MM
+    if abs(float(v)) > limit:
+        raise RobotFileError(f"key '{k}' = {_shown(v)} {unit} is beyond +-{limit:g} {unit}: not a robot's "
+                             f"(robot files are in mm and degrees)", where=where(k))
 
 
 def _check_keys(keys: dict, where) -> None:
@@ -364,6 +373,26 @@ def read_toml(path, error, what: str) -> dict:
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+)", str(exc))
         raise error(f"not valid TOML: {exc}", where=f"{path}:{m.group(1)}" if m else str(path)) from None
+    except RecursionError:  # arrays or tables nested thousands deep: the parser's recursion ends first
+        line = _deepest_line(text)
+        raise error("not valid TOML here: arrays or inline tables nested too deeply",
+                    where=f"{path}:{line}" if line else str(path)) from None
+
+
+def _deepest_line(text: str):
+    """The line (1-based) where brackets/braces nest deepest, or None."""
+    depth = best = 0
+    line = where = 1
+    for ch in text:
+        if ch == "\n":
+            line += 1
+        elif ch in "[{":
+            depth += 1
+            if depth > best:
+                best, where = depth, line
+        elif ch in "]}":
+            depth = max(depth - 1, 0)
+    return where if best else None
 
 
 def _register_module(keys: dict, path: Path, where) -> None:
