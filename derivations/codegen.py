@@ -326,7 +326,7 @@ def generate(out_dir: Path | None = None, check_forms: bool = True, derived: dic
     files = {}
     for name, modname in MECHANISMS.items():
         mod = importlib.import_module(modname)
-        sources = [HERE / "mechanism.py", HERE / "codegen.py", Path(mod.__file__)]
+        sources = [HERE / "mechanism.py", HERE / "codegen.py", HERE / "geometry.py", Path(mod.__file__)]
         files[out_dir / f"{name}.py"] = render(derived[name], sources, derivation=modname)
     return files
 

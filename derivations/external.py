@@ -53,7 +53,8 @@ def default_out(derivation) -> Path:
 
 def sources_of(derivation) -> list:
     """The files the inputs hash of a derivation's generated module covers."""
-    return [codegen.HERE / "mechanism.py", codegen.HERE / "codegen.py", Path(derivation).resolve()]
+    return [codegen.HERE / "mechanism.py", codegen.HERE / "codegen.py", codegen.HERE / "geometry.py",
+            Path(derivation).resolve()]
 
 
 def _one_line(exc: BaseException) -> str:

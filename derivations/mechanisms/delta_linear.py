@@ -34,34 +34,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from derivations.geometry import trilaterate
 from derivations.mechanism import HOME_WORKSPACE_CENTRE, SourceError, SymbolicMechanism, derive
 
 TOWERS = (1, 2, 3)
-
-
-def _cross(a, b):
-    return sp.Matrix([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _norm(v):
-    return sp.sqrt(v.dot(v))
-
-
-def trilaterate(p, radii):
-    """The intersection of three spheres (centres ``p``, ``radii``) below the plane of the centres."""
-    d21, d31 = p[1] - p[0], p[2] - p[0]
-    dd = _norm(d21)
-    ex_ = d21 / dd
-    ii = ex_.dot(d31)
-    ey_raw = d31 - ii * ex_
-    ey_ = ey_raw / _norm(ey_raw)
-    ez_ = _cross(ex_, ey_)
-    jj = ey_.dot(d31)
-    xs = (radii[0] ** 2 - radii[1] ** 2 + dd**2) / (2 * dd)
-    ys = (radii[0] ** 2 - radii[2] ** 2 + ii**2 + jj**2) / (2 * jj) - ii * xs / jj
-    hs = sp.sqrt(radii[0] ** 2 - xs**2 - ys**2)
-    # the sign of ez_z picks the intersection below the plane of the three centres
-    return p[0] + xs * ex_ + ys * ey_ - sp.sign(ez_[2]) * hs * ez_
 
 
 def build() -> SymbolicMechanism:

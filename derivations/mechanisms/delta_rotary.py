@@ -31,17 +31,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from derivations.geometry import trilaterate
 from derivations.mechanism import SourceError, SymbolicMechanism, derive
 
 LIMBS = (1, 2, 3)
-
-
-def _cross(a, b):
-    return sp.Matrix([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _norm(v):
-    return sp.sqrt(v.dot(v))
 
 
 def build() -> SymbolicMechanism:
@@ -80,19 +73,7 @@ def build() -> SymbolicMechanism:
 
     # --- forward kinematics: trilateration of the spheres (B_i - r e_i, l_i), smaller z
     p = [B[i] - r * e[i] for i in range(3)]
-    d21, d31 = p[1] - p[0], p[2] - p[0]
-    dd = _norm(d21)
-    ex_ = d21 / dd
-    ii = ex_.dot(d31)
-    ey_raw = d31 - ii * ex_
-    ey_ = ey_raw / _norm(ey_raw)
-    ez_ = _cross(ex_, ey_)
-    jj = ey_.dot(d31)
-    xs = (ll[0] ** 2 - ll[1] ** 2 + dd**2) / (2 * dd)
-    ys = (ll[0] ** 2 - ll[2] ** 2 + ii**2 + jj**2) / (2 * jj) - ii * xs / jj
-    hs = sp.sqrt(ll[0] ** 2 - xs**2 - ys**2)
-    # the sign of ez_z picks the intersection below the plane of the three centres
-    fk = p[0] + xs * ex_ + ys * ey_ - sp.sign(ez_[2]) * hs * ez_
+    fk = trilaterate(p, ll)
 
     # --- singularity indicators
     w = [fore[i] / ll[i] for i in range(3)]

@@ -33,19 +33,12 @@ from __future__ import annotations
 
 import sympy as sp
 
+from derivations.geometry import cross, norm
 from derivations.mechanism import Determinant, FkSolve, SourceError, SymbolicMechanism, derive
 
 LEGS = (1, 2, 3, 4, 5, 6)
 #: the rotation columns of the singularity indicator's matrix are scaled by this length (mm)
 ROTATION_SCALE_MM = 100
-
-
-def _cross(a, b):
-    return sp.Matrix([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _norm(v):
-    return sp.sqrt(v.dot(v))
 
 
 def rotation(roll, pitch, yaw):
@@ -62,8 +55,8 @@ def _leg_matrix(P, Rot, B, p):
     rows = []
     for Bi, pi in zip(B, p):
         w = P + Rot * pi - Bi
-        u = w / _norm(w)
-        rows.append(list(u) + list(_cross(Rot * pi, u) / ROTATION_SCALE_MM))
+        u = w / norm(w)
+        rows.append(list(u) + list(cross(Rot * pi, u) / ROTATION_SCALE_MM))
     return sp.Matrix(rows)
 
 
@@ -89,8 +82,8 @@ def build() -> SymbolicMechanism:
 
     home = sp.Matrix([0, 0, z_home, 0, 0, 0])
     P_home = sp.Matrix([0, 0, z_home])
-    home_length = [_norm(P_home + p[i] - B[i]) for i in range(6)]
-    ik = sp.Matrix([_norm(w) for w in legs])
+    home_length = [norm(P_home + p[i] - B[i]) for i in range(6)]
+    ik = sp.Matrix([norm(w) for w in legs])
     ratio = sp.Matrix([(ik[i] - home_length[i]) / stroke for i in range(6)])
 
     det, det_home = sp.Symbol("det_M", real=True), sp.Symbol("det_M_home", real=True)
@@ -109,9 +102,9 @@ def build() -> SymbolicMechanism:
     def rigid(points, carriers, extra, extra_names, t, w):
         kw = {}
         for pt, car in zip(points, carriers):
-            mv = t + _cross(w, pt)
+            mv = t + cross(w, pt)
             kw.update({str(car[k]): mv[k] for k in range(3)})
-        mv = t + _cross(w, extra)
+        mv = t + cross(w, extra)
         kw.update({extra_names[k]: mv[k] for k in range(3)})
         return [kw.get(nm, 0) for nm in names]
 

@@ -1,8 +1,8 @@
 """Generated CasADi builders for the mechanism ``delta_linear``.
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
-source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_linear.py
-inputs hash: 059e8ea540e425c4
+source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/delta_linear.py
+inputs hash: 080dfb2abb99c2f3
 sympy: 1.14.0
 """
 import casadi as ca

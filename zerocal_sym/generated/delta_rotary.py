@@ -1,8 +1,8 @@
 """Generated CasADi builders for the mechanism ``delta_rotary``.
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
-source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 0e5f4cce76292619
+source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
+inputs hash: c8b9c6693ac6318d
 sympy: 1.14.0
 """
 import casadi as ca

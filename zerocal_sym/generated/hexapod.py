@@ -1,8 +1,8 @@
 """Generated CasADi builders for the mechanism ``hexapod``.
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
-source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/hexapod.py
-inputs hash: 42cb3a18875a2a15
+source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/hexapod.py
+inputs hash: 7a5b06fb05dfef00
 sympy: 1.14.0
 """
 import casadi as ca

@@ -1,8 +1,8 @@
 """Generated CasADi builders for the mechanism ``planar_2dof``.
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
-source: derivations/codegen.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: e79edf08cebe6b46
+source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
+inputs hash: de3321a116718645
 sympy: 1.14.0
 """
 import casadi as ca

@@ -16,7 +16,7 @@ from zerocal_sym.model import units
 
 
 @dataclass
-class IdentificationResult:
+class IdentificationResult(units.DegreeViews):
     """One identification.
 
     Attributes
@@ -100,27 +100,10 @@ class IdentificationResult:
         """File unit of the zero offsets: ``deg`` (revolute joints) or ``mm`` (prismatic)."""
         return self.errors.offset_user_unit
 
-    def _revolute(self, what):
-        if self.errors.offset_unit != "rad":
-            raise AttributeError(f"{what}: the zero offsets of this mechanism are lengths (mm); use "
-                                 f"{what.replace('_deg', '_user').replace('_rad', '')}")
-
     @property
     def zero_offsets_rad(self) -> np.ndarray:
         """Zero offsets in joint order (rad), shape (m,): revolute joints."""
-        self._revolute("zero_offsets_rad")
-        return self.zero_offsets
-
-    @property
-    def zero_offsets_deg(self) -> np.ndarray:
-        """Zero offsets in joint order (deg), shape (m,): revolute joints."""
-        self._revolute("zero_offsets_deg")
-        return self.zero_offsets_user
-
-    @property
-    def std_zero_offsets_deg(self) -> np.ndarray:
-        self._revolute("std_zero_offsets_deg")
-        return self.std_zero_offsets_user
+        return self._degrees("zero_offsets_rad", self.zero_offsets)
 
     @property
     def maemm_mm(self) -> np.ndarray:

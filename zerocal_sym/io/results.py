@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
+from zerocal_sym.model.units import DegreeViews
 from zerocal_sym.io.csvtext import (_json_line, _load_json, _read_text, get_mechanism_of, read_as,
                                     unknown_mechanism_message, with_reading_hint)
 
@@ -65,7 +66,7 @@ SHA256_RE = re.compile(r"[0-9a-fA-F]{64}")
 
 
 @dataclass
-class ResultFile:
+class ResultFile(DegreeViews):
     """The parts of a results JSON that a compensation needs.
 
     Attributes
@@ -113,22 +114,6 @@ class ResultFile:
         from zerocal_sym.model.units import from_user
 
         return from_user(self.zero_offsets_user, "rad" if self.offset_unit == "deg" else "mm")
-
-    @property
-    def zero_offsets_deg(self) -> np.ndarray:
-        """The zero offsets in deg (revolute joints; :attr:`zero_offsets_user` for any)."""
-        self._revolute("zero_offsets_deg")
-        return self.zero_offsets_user
-
-    @property
-    def std_zero_offsets_deg(self) -> np.ndarray:
-        self._revolute("std_zero_offsets_deg")
-        return self.std_zero_offsets_user
-
-    def _revolute(self, what):
-        if self.offset_unit != "deg":
-            raise AttributeError(f"{what}: these zero offsets are in {self.offset_unit}; use "
-                                 f"{what.replace('_deg', '_user')}")
 
     @property
     def m(self) -> int:

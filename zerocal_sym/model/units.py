@@ -135,3 +135,25 @@ def rename_unit_keys(obj, unit: str, stem: str = "_deg"):
     if isinstance(obj, list):
         return [rename_unit_keys(v, unit, stem) for v in obj]
     return obj
+
+
+class DegreeViews:
+    """The ``_deg`` views of zero offsets kept for revolute joints (the names files and code had before prismatic
+    joints): a class with ``offset_unit`` (file unit), ``zero_offsets_user`` and ``std_zero_offsets_user`` gets
+    ``zero_offsets_deg`` and ``std_zero_offsets_deg``, which raise AttributeError for offsets in mm."""
+
+    def _degrees(self, what, values):
+        if self.offset_unit != "deg":
+            raise AttributeError(f"{what}: these zero offsets are in {self.offset_unit}; use "
+                                 f"{what.replace('_deg', '_user').replace('_rad', '')}")
+        return values
+
+    @property
+    def zero_offsets_deg(self):
+        """The zero offsets in deg (revolute joints; ``zero_offsets_user`` for any)."""
+        return self._degrees("zero_offsets_deg", self.zero_offsets_user)
+
+    @property
+    def std_zero_offsets_deg(self):
+        """Their standard deviations in deg (revolute joints; ``std_zero_offsets_user`` for any)."""
+        return self._degrees("std_zero_offsets_deg", self.std_zero_offsets_user)
