@@ -99,7 +99,7 @@ def test_the_page_recipe_runs_outside_the_repository(recipe):
     r = _run_of(runs, f"zerocal regen --derivation {NAME}.py")
     assert r.stdout == f"wrote {gen.name} (mechanism {NAME})\n"
     head = gen.read_text()[:800]
-    assert f"source: derivations/codegen.py, derivations/mechanism.py, {NAME}.py" in head
+    assert f"source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, {NAME}.py" in head
     assert f"DERIVATION = '{NAME}.py'" in head and f"zerocal regen --derivation {NAME}.py" in head
     assert str(work) not in gen.read_text()  # nothing of this machine's paths: the directory may move
     assert "up to date" in _run_of(runs, f"zerocal regen --derivation {NAME}.py --check").stdout

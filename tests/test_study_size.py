@@ -46,7 +46,8 @@ def _refused(capsys, spec, out, line, *words):
 def test_n_beyond_the_cli_cap(tmp_path, capsys):
     """n = 1,000,000 made 2,000,000 poses before anything was said."""
     spec = _spec(tmp_path, n=1_000_000)
-    _refused(capsys, spec, tmp_path / "out", 8, f"n = 1000000: at most {MAX_N} poses per boundary", "--n")
+    _refused(capsys, spec, tmp_path / "out", 8, f"n = 1000000: expected an integer >= 2 and <= {MAX_N} (poses per "
+             "boundary)")
 
 
 def test_absurd_trials(tmp_path, capsys):

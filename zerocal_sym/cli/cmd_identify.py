@@ -263,6 +263,8 @@ def run(args):
     import contextlib
     import sys
 
+    import numpy as np
+
     from zerocal_sym.cli import load_robot_arg
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.identify.identifiability import format_report, identifiability_report
@@ -329,8 +331,20 @@ def run(args):
 
         if args.max_iter is not None and args.max_iter < 1:
             raise ZerocalError("--max-iter must be >= 1")
-        res = identify_nlls(robot, meas, names, noise=noise, prior=prior, bounds=bounds or None,
-                            prior_std=pstd or None, max_iter=args.max_iter, **trust_kwargs(args, "nlls"))
+        try:
+            res = identify_nlls(robot, meas, names, noise=noise, prior=prior, bounds=bounds or None,
+                                prior_std=pstd or None, max_iter=args.max_iter, **trust_kwargs(args, "nlls"))
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+            # linear algebra that failed on these data (a robust refit or a leave-one-out where the exact model is
+            # not finite): a refusal naming the likely cause, never a traceback
+            print(f"zerocal identify: identification failed ({args.method}): the data do not fit the model "
+                  f"anywhere near (the linear algebra failed: {exc}); no calibration written", file=sys.stderr)
+            print("Likely cause: rows shuffled, reversed, cumulative or dropped, or another robot's file.",
+                  file=sys.stderr)
+            if not args.json:
+                print("verdict: rejected: the identification failed on these data; next: check the rows against "
+                      "the poses you visited and the robot file, and identify again")
+            return 1
     err0 = evaluation_point(robot, meas, res, prior)
     report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=err0)
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)

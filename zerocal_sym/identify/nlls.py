@@ -187,9 +187,16 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
     sol = solve(prob, z0, par, reweight, bounds is not None, lbx, ubx, max_iter, K)
     robust = A = None
+    robust_failed = None
     if loss != "l2":
-        robust, A = robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w,
-                                  mu * scale, K)
+        try:
+            robust, A = robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w,
+                                      mu * scale, K)
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+            # the robust refit's linear algebra failed on these data (the model not finite at its estimate, a
+            # covariance that is no covariance there): not a calibration, and the status says so
+            robust_failed = str(exc)
+            sol.converged = False
     r, rp, J, pred, l, b = sol.r, sol.rp, sol.J, sol.pred, sol.l, sol.b
     Jd = J[: K - 1]  # data part of the Jacobian (whitened, per scaled unit)
     svd, sv, rank, cov, nonid, offsets_ok = information(J, Jd, r, K, has_prior, noise, scale, names, errors)
@@ -218,7 +225,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         info["prior_whitener"] = w.tolist()
     res = IdentificationResult(method="nlls", params=names, estimate=sol.z / scale,
                                covariance=cov, success=bool(success),
-                               status=status_line(sol, offsets_ok, rank, names, robust, loss),
+                               status=(status_line(sol, offsets_ok, rank, names, robust, loss)
+                                       + (f"; the {loss} refit failed: {robust_failed}" if robust_failed else "")),
                                residuals=np.asarray(s - pred), info=info, errors=errors,
                                std_kind="from residuals" if noise.is_zero else "total")
     # the fit check: whitened exact-model residuals at the estimate against the noise model
