@@ -424,7 +424,7 @@ def _run_target(args, robot):
           f"{out['approximate']['n_candidates']} candidate poses can reach it")
     a = out["approximate"]
     print("  support of the design measure (file units, weight): "
-          + "; ".join(f"{tuple(round(float(x), 2) for x in poses_to_user(robot, np.asarray(s_)))} {w:.3f}"
+          + "; ".join(f"{tuple(round(float(x), 2) for x in s_)} {w:.3f}"
                       for s_, w in zip(a["support"], a["support_weights"])))
     print("  evaluated K: " + ", ".join(f"{kk} -> {v:.5g}" for kk, v in out["evaluated"].items()))
     print(f"  ({out['time_s']:.1f} s; the {out['K']} poses: --json)")

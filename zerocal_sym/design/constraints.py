@@ -40,7 +40,8 @@ import numpy as np
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 from zerocal_sym.model.kinematics import fmt_user_pose
-from zerocal_sym.design.terms import _call_ik, _reachable, pose_distances, pose_terms, poses_from_user, poses_to_user
+from zerocal_sym.design.terms import (_call_ik, _reachable, pose_distances, pose_terms, pose_units, poses_from_user,
+                                      poses_to_user)
 from zerocal_sym.design.limits import SCALE_RANGE_MM, TRAVEL_MODES, _FEAS_TOL, DesignError, _finite
 from zerocal_sym.design.shapes import make_region
 
@@ -206,7 +207,8 @@ def _check_region_reachable(robot, region):
     grid = region.reach_grid()
     th, ratio = _call_ik(robot, grid)
     bad = np.flatnonzero(~_reachable(ratio, th))
-    ws = f"the robot's workspace is {robot.workspace.describe()} mm"
+    mm = set(pose_units(robot)) == {"mm"}
+    ws = f"the robot's workspace is {robot.workspace.describe()}{' mm' if mm else ''}"
     if bad.size:
         raise DesignError(f"region {region_text(region)} is not reachable: {_fp(robot, grid[bad[0]])} cannot "
                           f"be reached ({bad.size} of {len(grid)} grid points unreachable); {ws}")

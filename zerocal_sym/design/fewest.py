@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from zerocal_sym.design.constraints import Constraints, make_constraints
 from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.rounding import realize
-from zerocal_sym.design.terms import offset_unit, offsets_from_user, okey
+from zerocal_sym.design.terms import offset_unit, offsets_from_user, okey, poses_to_user
 
 if TYPE_CHECKING:
     from zerocal_sym.design.approx import ApproxDesign
@@ -107,4 +107,5 @@ def fewest_poses(robot, target: float, cons: Constraints | None = None, noise=No
     return {"K": int(hi), "K_lower_bound": int(k_lb), "unit": u, okey(robot, "target_crlb"): target,
             okey(robot, "crlb_rms"): float(v),
             "poses": designs[hi], "evaluated": {int(k): float(x) for k, x in sorted(evaluated.items())},
-            "approximate": ad.to_dict(hi), "time_s": time.perf_counter() - t0}
+            "approximate": dict(ad.to_dict(hi), support=poses_to_user(robot, ad.support).tolist()),
+            "time_s": time.perf_counter() - t0}

@@ -46,7 +46,7 @@ from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objecti
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
-from zerocal_sym.design.terms import describe_noise, noise_dict
+from zerocal_sym.design.terms import describe_noise, noise_dict, poses_to_user
 
 
 # --------------------------------------------------------------------------- baseline
@@ -386,6 +386,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         timing["round_order"] = time.perf_counter() - t1
         label = "approximate +round +order"
         approx_info = mad.to_dict(K)
+        approx_info["support"] = poses_to_user(robot, mad.support).tolist()  # file units, as the poses
         approx_info["counts"] = info["counts"]
         approx_info["orders_tried"] = info["orders_tried"]
     else:
