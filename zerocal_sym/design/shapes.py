@@ -215,7 +215,7 @@ def corner_scheme(lo, hi, K: int) -> np.ndarray:
     -------
     ndarray, shape (K, n)
     """
-    from zerocal_sym.model.workspace import BOX_FRACTIONS
+    from zerocal_sym.model.workspace import BOX_FRACTIONS, corner_points
 
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     n = len(lo)
@@ -224,16 +224,7 @@ def corner_scheme(lo, hi, K: int) -> np.ndarray:
     if N is None:
         raise DesignError(f"the corner rule has at most {sizes[-1]} corners in {n}-D, got K = {K}")
     gens = BOX_FRACTIONS[N] if n == 6 else {}
-    free = [j for j in range(n) if j not in gens]
-    out = []
-    for k in range(K):
-        bits = [0] * n
-        for i, j in enumerate(free):
-            bits[j] = (k >> i) & 1
-        for j, src in gens.items():
-            bits[j] = int(np.bitwise_xor.reduce([bits[i] for i in src]))
-        out.append(np.where(bits, hi, lo))
-    return np.array(out)
+    return corner_points(lo, hi, K, gens)
 
 
 @dataclass(frozen=True)

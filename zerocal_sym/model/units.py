@@ -76,24 +76,24 @@ def joint_unit(mech) -> str:
     return getattr(mech, "mechanism", mech).joint_user_unit
 
 
-def pose_to_user(mech, P):
-    """Poses (shape (..., n)) in file units: orientation coordinates in degrees."""
+def _convert_orientations(mech, P, fn):
+    """A copy of the poses ``P`` (shape (..., n)) with ``fn`` applied to the orientation coordinates."""
     mech = getattr(mech, "mechanism", mech)
     P = np.array(P, float)
     for i, name in enumerate(mech.pose_names):
         if mech.pose_units.get(name, "mm") == "rad":
-            P[..., i] = np.degrees(P[..., i])
+            P[..., i] = fn(P[..., i])
     return P
+
+
+def pose_to_user(mech, P):
+    """Poses (shape (..., n)) in file units: orientation coordinates in degrees."""
+    return _convert_orientations(mech, P, np.degrees)
 
 
 def pose_from_user(mech, P):
     """Poses (shape (..., n)) from file units (degrees for orientations) to internal units."""
-    mech = getattr(mech, "mechanism", mech)
-    P = np.array(P, float)
-    for i, name in enumerate(mech.pose_names):
-        if mech.pose_units.get(name, "mm") == "rad":
-            P[..., i] = np.radians(P[..., i])
-    return P
+    return _convert_orientations(mech, P, np.radians)
 
 
 def pose_unit(mech, name: str) -> str:

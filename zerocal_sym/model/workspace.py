@@ -263,6 +263,27 @@ BOX_FRACTIONS = {
 }
 
 
+def corner_points(lo, hi, K: int, gens: dict) -> np.ndarray:
+    """K corners of the box ``[lo, hi]`` (n-D): k runs over the free coordinates' bits (coordinate j at its
+    maximum where its bit is 1), each coordinate of ``gens`` (j -> source coordinates) the XOR of its sources'.
+
+    Returns
+    -------
+    ndarray, shape (K, n)
+    """
+    n = len(lo)
+    free = [j for j in range(n) if j not in gens]
+    out = []
+    for k in range(K):
+        bits = [0] * n
+        for i, j in enumerate(free):
+            bits[j] = (k >> i) & 1
+        for j, src in gens.items():
+            bits[j] = int(np.bitwise_xor.reduce([bits[i] for i in src]))
+        out.append(np.where(bits, hi, lo))
+    return np.array(out)
+
+
 @dataclass(frozen=True)
 class Box(_Shape):
     """The 6-D box ``|x|, |y| <= a``, ``z in [z_min, z_max]``, ``|roll|, |pitch| <= tilt_max``, ``|yaw| <= yaw_max``.
@@ -352,17 +373,8 @@ class Box(_Shape):
             raise PoseError(f"the corner scheme has n = {', '.join(str(k) for k in sorted(BOX_FRACTIONS))} corners "
                             f"(all 64 or a regular fraction), got n = {n}")
         gens = BOX_FRACTIONS[n]
-        free = [j for j in range(6) if j not in gens]
         lo, hi = self.bounds()
-        out = []
-        for k in range(n):
-            bits = [0] * 6
-            for i, j in enumerate(free):
-                bits[j] = (k >> i) & 1
-            for j, src in gens.items():
-                bits[j] = int(np.bitwise_xor.reduce([bits[i] for i in src]))
-            out.append(np.where(bits, hi, lo))
-        return np.array(out)
+        return corner_points(lo, hi, n, gens)
 
 
 SHAPES = {"rectangle": Rectangle, "cylinder": Cylinder, "box": Box}
