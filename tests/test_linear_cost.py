@@ -74,7 +74,13 @@ def _flat(x):
     return [v for e in x for v in _flat(e)] if isinstance(x, list) else [x]
 
 
+#: Ipopt's two successful ends: which one a point within ``acceptable_tol`` but short of ``tol`` gets depends on the
+#: Ipopt version (the oldest declared CasADi's says Solve_Succeeded where the newest says the other), not on our code
+_IPOPT_SUCCESS = re.compile(r"Solved_To_Acceptable_Level|Solve_Succeeded")
+
+
 def _compare_text(a, b, path):
+    a, b = _IPOPT_SUCCESS.sub("<ipopt success>", a), _IPOPT_SUCCESS.sub("<ipopt success>", b)
     assert _NUMBER.sub("#", a) == _NUMBER.sub("#", b), (path, a, b)
     for x, y in zip(_NUMBER.findall(a), _NUMBER.findall(b)):
         assert float(y) == pytest.approx(float(x), rel=TEXT_RTOL, abs=0), (path, a, b)
@@ -168,13 +174,12 @@ def test_identifications_agree_with_the_reference(cid):
     """Every identification of the reference set (tests/reference_cases.py): estimates, covariances, the fit
     check and its per-reading statistics, the causes of a rejection, the robust loss's weights and outliers,
     the one-step deletion diagnostics -- to the round-off of the whitened problem at the point, and to the
-    stopping tolerance of the iteration that made the point (its estimate's K > EXPAND_MAX_K: numpy Gauss-
-    Newton and Ipopt on callbacks instead of the CasADi graph; the robust loss: banded IRLS at every K; the
+    stopping tolerance of the iteration that made the point (Gauss-Newton and Ipopt at every K, on the CasADi
+    graph or, K > EXPAND_MAX_K, numpy and callbacks; the robust loss: banded IRLS at every K; the
     refit naming a bad reading: the leave-one-out refits)."""
     case, ref, new = _recompute(cid)
     robot = rc.robot_of(case[1])
     direct = direct_rtol(ref)
-    big = ref["K"] > EXPAND_MAX_K
     for what, a in ref.items():
         if not isinstance(a, dict) or what == "deletion-refit":
             continue
@@ -183,8 +188,11 @@ def test_identifications_agree_with_the_reference(cid):
         # TSVD's covariance holds its linearisation bias b b^T, b = estimate - a Gauss-Newton minimum started at
         # the estimate: that point is made to the Gauss-Newton stopping tolerance, whatever K (a start that moves
         # by round-off -- the identification matrix G evaluated in another order -- stops elsewhere within it)
-        tau = {"huber": max(IRLS_TOL, GN_STEP_TOL), "soft_l1": max(IRLS_TOL, GN_STEP_TOL)}.get(
-            what, GN_STEP_TOL if big or what.startswith("tsvd") else 0.0)
+        # every estimate is the end of an iteration (Gauss-Newton, then Ipopt's confirmation): whatever K, it is
+        # defined to the Gauss-Newton stopping tolerance, not to round-off -- the same code on other numpy, CasADi
+        # or Ipopt versions stops elsewhere within it (a misfit round converges linearly: measured 7e-7 relative on
+        # planar-bad-24 between the newest and the oldest declared versions)
+        tau = {"huber": max(IRLS_TOL, GN_STEP_TOL), "soft_l1": max(IRLS_TOL, GN_STEP_TOL)}.get(what, GN_STEP_TOL)
         rtol = direct + point_rtol(ref, z, tau)
         # the chi2 of an exact (noise-free) fit is round-off: K - 1 whitened residuals of eps * rho / sigma each
         # (rho < 2000 mm, sigma = 1 um: the noise-free weighting), 16 ulp of margin
@@ -229,11 +237,15 @@ def test_deletion_refits_agree_with_the_reference(cid):
     for ra, rb in zip(a["readings"], b["readings"]):
         assert ra["pose"] == rb["pose"] and (ra["change"] is None) == (rb["change"] is None)
         compare({k: ra[k] for k in ("leverage", "standardised")}, {k: rb[k] for k in ("leverage", "standardised")},
-                direct_rtol(ref) + point_rtol(ref, z, GN_STEP_TOL if ref["K"] > EXPAND_MAX_K else 0.0))
+                direct_rtol(ref) + point_rtol(ref, z, GN_STEP_TOL))
         if rb["refit_converged"]:
             converged.append((ra, rb))
             for k, n in enumerate(names):
-                tol = e.to_user_value(n, 2 * REFIT_TOL / scale[k])
+                # a change is the refit's point minus the full fit's estimate: each defined to its own iteration's
+                # tolerance -- the refit to REFIT_TOL, the estimate as its difference from the reference's shows (a
+                # misfit round's estimate is where Ipopt stopped, which moves between Ipopt versions)
+                moved = abs(e.to_user_value(n, new["nlls"]["estimate"][k] - ref["nlls"]["estimate"][k]))
+                tol = e.to_user_value(n, 2 * REFIT_TOL / scale[k]) + moved
                 assert abs(rb["change"][n] - ra["change"][n]) <= tol, (ra["pose"], n, ra["change"][n], rb["change"][n])
         else:
             assert (chi2_sf(ra["chi2_without"], dof) < DEFAULT_ALPHA) == (chi2_sf(rb["chi2_without"], dof) < DEFAULT_ALPHA)
