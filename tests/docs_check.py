@@ -263,7 +263,8 @@ def _tokens(expected: str, bounds: bool):
             toks.append(("text", re.compile(r"\s+".join(re.escape(w) if w else "" for w in re.split(r"\s+", t)))))
 
     for m in token.finditer(expected):
-        text(expected[pos:m.start()])
+        before = expected[pos:m.start()]
+        text(before.rstrip() if m.group(1) else (before.lstrip() if toks and toks[-1][0] == "any" else before))
         if m.group(1):
             toks.append(("any",))
         elif bounds and m.group(2):
@@ -271,7 +272,7 @@ def _tokens(expected: str, bounds: bool):
         else:
             toks.append(("num", "=", m.group(m.lastindex)))
         pos = m.end()
-    text(expected[pos:])
+    text(expected[pos:].lstrip() if toks and toks[-1][0] == "any" else expected[pos:])
     return toks
 
 

@@ -64,6 +64,7 @@ def test_numbers_compare_at_the_digits_shown():
     assert dc.line_matches("tsvd-loop ... 59 ...", "tsvd-loop  +0.0105, 0.3856  0   59   9.2  0.71")[0]
     assert not dc.line_matches("loop ... 0.5 mm", "loop -0.5 mm")[0] and not dc.line_matches("a ... 9 b", "a 59 b")[0]
     assert dc.line_matches("nlls ... 1.001", "x  nlls  0.63  1.001,1.001", search=True)[0]
+    assert dc.line_matches("ours 3185.7 ... reference 3186", "ours 3185.745  reference 3186")[0]
     # words holding digits are text: theta1, P1, a hash
     assert not dc.line_matches("theta1 = 2", "theta2 = 2")[0] and dc.line_matches("sha256: 2eaac3", "sha256: 2eaac3")[0]
 
