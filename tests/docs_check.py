@@ -561,27 +561,39 @@ def run_page(page: Page, directory: Path):
 
 
 class SharedCache:
-    """Results of slow items, once per test session across pytest-xdist workers (a file per item, a lock)."""
+    """Runs once per test session, also across pytest-xdist workers: a page's fast items, a slow item.
+
+    Each run has a directory under ``root`` and a result file beside it; a lock file serialises the workers, so a
+    second asker waits for the first run and reads its result (and may look at the files it wrote).
+    """
 
     def __init__(self, root: Path):
         self.root = root
         root.mkdir(parents=True, exist_ok=True)
 
-    def results(self, item: Item, files):
-        key = hashlib.sha256(json.dumps([c.text for c in item.commands]).encode()).hexdigest()[:16]
+    def _once(self, key: str, run):
         path, lock = self.root / f"{key}.json", self.root / f"{key}.lock"
         with open(lock, "w") as fh:
             try:
                 import fcntl
 
                 fcntl.flock(fh, fcntl.LOCK_EX)
-            except ImportError:  # no file locks here: at worst two workers run the item
+            except ImportError:  # no file locks here: at worst two workers run the same thing
                 pass
-            if path.exists():
-                return json.loads(path.read_text())
-            res = run_commands([c.text for c in item.commands], scratch(self.root / key, files))
-            path.write_text(json.dumps(res))
-            return res
+            if not path.exists():
+                path.write_text(json.dumps(run(self.root / key)))
+            return json.loads(path.read_text())
+
+    def results(self, item: Item, files):
+        """A slow item's ``[(status, stdout, stderr)]``, its commands run in a fresh directory."""
+        key = "item-" + hashlib.sha256(json.dumps([c.text for c in item.commands]).encode()).hexdigest()[:16]
+        return self._once(key, lambda d: run_commands([c.text for c in item.commands], scratch(d, files)))
+
+    def page(self, page: Page):
+        """``(directory, problems)`` of the page's fast items, run in order in ``directory``."""
+        key = "page-" + re.sub(r"\W", "_", _rel(page.path))
+        problems = self._once(key, lambda d: run_page(page, d))
+        return self.root / key, problems
 
 
 def judge_item(item: Item, results):

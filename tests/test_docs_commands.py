@@ -5,7 +5,6 @@ runs its commands in order in a scratch directory (the fast ones); each slow blo
 marked slow, run once per test session (also across pytest-xdist workers) and kept for any page that shows the same
 commands.  Another test finds every ``zerocal`` command in a fenced block and asks that it is run or says why not.
 """
-import os
 from pathlib import Path
 
 import pytest
@@ -18,26 +17,19 @@ SLOW = [pytest.param(name, k, id=f"{name}:{it.line}")
         for name, page in PAGES.items() for k, it in enumerate(page.items) if it.slow]
 
 
-@pytest.fixture(scope="session")
-def shared_cache(tmp_path_factory):
-    """One directory for the whole session: with pytest-xdist, the workers' base directories' parent."""
-    base = tmp_path_factory.getbasetemp()
-    return dc.SharedCache((base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "docs-check-cache")
-
-
 @pytest.mark.parametrize("name", FAST)
-def test_page_prints_what_it_shows(name, tmp_path):
-    problems = dc.run_page(PAGES[name], tmp_path / "page")
+def test_page_prints_what_it_shows(name, docs_runs):
+    _, problems = docs_runs.page(PAGES[name])
     assert not problems, f"{len(problems)} difference(s) between {name} and what its commands print:\n" + \
         "\n".join(problems)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,k", SLOW)
-def test_slow_item_prints_what_the_page_shows(name, k, shared_cache):
+def test_slow_item_prints_what_the_page_shows(name, k, docs_runs):
     page = PAGES[name]
     item = page.items[k]
-    problems = dc.judge_item(item, shared_cache.results(item, page.files))
+    problems = dc.judge_item(item, docs_runs.results(item, page.files))
     assert not problems, "\n".join(problems)
 
 
