@@ -53,10 +53,10 @@ EXAMPLES = ROOT / "examples"
 PAGES = [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 
 #: a number as a page prints it: not the tail of a word (``theta1``, ``P1``) nor the head of one (``2eaac3``)
-NUMBER = r"(?<![\w.])[-+]?(?:\d+(?:\.\d+)?|\.\d+)(?:[eE][-+]?\d+)?(?![\w]|\.\d)"
+NUMBER = r"(?<![\w.])(?<![\w.][-+])[-+]?(?:\d+(?:\.\d+)?|\.\d+)(?:[eE][-+]?\d+)?(?![\w]|\.\d)"
 #: the same inside an output line: a captured number, signed or not, any digits
 ANY_NUMBER = r"([-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?)"
-BOUND = r"\{(<=?)\s*(" + NUMBER[len(r"(?<![\w.])"):] + r")\}"
+BOUND = r"\{(<=?)\s*(" + NUMBER[len(r"(?<![\w.])(?<![\w.][-+])"):] + r")\}"
 MINUS = "\u2212"
 FENCE = re.compile(r"^(```+|~~~+)\s*([\w+-]*)\s*$")
 CHECK_OPEN = re.compile(r"^<!--\s*check(\s+slow)?:\s*(.*)$")
@@ -269,8 +269,8 @@ def _tokens(expected: str, bounds: bool):
             toks.append(("any",))
         elif bounds and m.group(2):
             toks.append(("num", m.group(2), m.group(3)))
-        else:
-            toks.append(("num", "=", m.group(m.lastindex)))
+        else:  # a number; right before ``...`` its digits go on: the printed number starts with them
+            toks.append(("num", "..." if expected.startswith("...", m.end()) else "=", m.group(m.lastindex)))
         pos = m.end()
     text(expected[pos:].lstrip() if toks and toks[-1][0] == "any" else expected[pos:])
     return toks
@@ -280,6 +280,8 @@ _ACTUAL_NUMBER = re.compile(ANY_NUMBER + r"(?![\w]|\.\d)")
 
 
 def _number_fails(got: str, op: str, want: str):
+    if op == "...":
+        return None if got.lstrip("+").startswith(want.lstrip("+")) else f"{got} where the page shows {want}..."
     v = float(got)
     if op == "=":
         return None if at_digits(v, want) else f"{got} where the page shows {want}"

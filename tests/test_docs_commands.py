@@ -57,6 +57,11 @@ def test_numbers_compare_at_the_digits_shown():
     assert not dc.line_matches("loop ... 0.5 mm", "loop -0.5 mm")[0] and not dc.line_matches("a ... 9 b", "a 59 b")[0]
     assert dc.line_matches("nlls ... 1.001", "x  nlls  0.63  1.001,1.001", search=True)[0]
     assert dc.line_matches("ours 3185.7 ... reference 3186", "ours 3185.745  reference 3186")[0]
+    # digits followed by an ellipsis: the printed number starts with them
+    assert dc.line_matches("theta1,-1.0637759...,0.6377426...", "theta1,-1.0637759353196776,0.6377426986548939")[0]
+    assert not dc.line_matches("x 0.637743...", "x 0.6377426986548939")[0]
+    # a sign glued to a word is text: M666 X0.120 Y-0.300
+    assert dc.line_matches("M666 X0.120 Y-0.300 Z0.050", "M666 X0.120 Y-0.300 Z0.050")[0]
     # words holding digits are text: theta1, P1, a hash
     assert not dc.line_matches("theta1 = 2", "theta2 = 2")[0] and dc.line_matches("sha256: 2eaac3", "sha256: 2eaac3")[0]
 

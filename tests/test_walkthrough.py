@@ -16,7 +16,6 @@ from zerocal_sym.cli import main
 from zerocal_sym.errors import DataFileError
 
 ROOT = Path(__file__).resolve().parents[1]
-MY_ROBOT = ROOT / "examples" / "my_robot.toml"
 
 
 def zc(capsys, *argv, expect=0):
