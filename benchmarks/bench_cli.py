@@ -1,6 +1,6 @@
 """Start-up time of the CLI: `zerocal --help` against a bare Python start.
 
-Target (issue 2): `zerocal --help` answers in under a second.
+Target: `zerocal --help` answers in under a second.
 Usage: python benchmarks/bench_cli.py [--repeat N]
 """
 import argparse

@@ -1,4 +1,4 @@
-"""Design time of `zerocal design --optimize` (issue 5) for K = 6 and K = 20, and the issue-13 cases.
+"""Design time of `zerocal design --optimize` for K = 6 and K = 20, and the extra cases (regions, approximate designs).
 
 For each K and criterion, times the full design (discrete exchange + Ipopt
 multi-start + order search + polish, :func:`zerocal_sym.design.optimize_design`)
@@ -6,14 +6,15 @@ and, as baselines measured in the same run, one Ipopt start (NLP build + one
 solve from the paper's scheme) and the discrete exchange alone; prints the
 ratios, the stage breakdown and what the design achieved.
 
-Issue 13 (printed after the table; ``--only-issue13`` skips the table): the K = 6 crlb design over the
-reachable set of the paper's robot with y >= 450 mm, the 350 mm travel limit and the default margin (its
+The extra cases (printed after the table; ``--only-extras`` skips the table): the K = 6 crlb design over
+the reachable set of the paper's robot with y >= 450 mm, the 350 mm travel limit and the default margin (its
 CRLB, the certified bound, the baseline); K = 100 designs (the approximate method: the exact one took
-1207 s at K = 100 before issue 13) on the paper's robot and the Delta; ``zerocal design --target-crlb 0.04``
-in the paper's workspace (the fewest K and its certified lower bound); each with its wall time.
+1207 s at K = 100 before the approximate design existed) on the paper's robot and the Delta;
+``zerocal design --target-crlb 0.04`` in the paper's workspace (the fewest K and its certified lower bound);
+each with its wall time.
 
 Usage: python benchmarks/bench_design.py [--repeat N] [--K 6 20] [--criteria crlb cond] [--starts 8]
-                                         [--only-issue13] [--no-issue13]
+                                         [--only-extras] [--no-extras]
 """
 import argparse
 import statistics
@@ -42,25 +43,25 @@ def main():
     ap.add_argument("--K", type=int, nargs="+", default=[6, 20])
     ap.add_argument("--criteria", nargs="+", default=["crlb", "cond"])
     ap.add_argument("--starts", type=int, default=8)
-    ap.add_argument("--only-extras", "--only-issue13", dest="only_issue13", action="store_true",
+    ap.add_argument("--only-extras", action="store_true",
                     help="only the extra cases (reachable set, approximate designs, fewest poses)")
-    ap.add_argument("--no-extras", "--no-issue13", dest="no_issue13", action="store_true",
+    ap.add_argument("--no-extras", action="store_true",
                     help="skip the extra cases")
     a = ap.parse_args()
-    if not a.only_issue13:
+    if not a.only_extras:
         table(a)
-    if not a.no_issue13:
-        issue13()
+    if not a.no_extras:
+        extras()
 
 
-def issue13():
+def extras():
     from zerocal_sym.design import approx
     from zerocal_sym.model.robot import load_robot
     from pathlib import Path
 
     robot, noise = paper_robot(), NoiseModel.paper()
     print()
-    print("issue 13 (paper noise, default margin, l0 = 350 mm range, seed 0, 8 + 8 starts on the exact path)")
+    print("extras (paper noise, default margin, l0 = 350 mm range, seed 0, 8 + 8 starts on the exact path)")
     t = time.perf_counter()
     cons = design.make_constraints(robot, region="reachable", bounds=(-float("inf"), float("inf"), 450,
                                                                        float("inf")))

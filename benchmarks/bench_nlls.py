@@ -21,7 +21,7 @@ Timed per identification (median over passes of the mean over the rounds):
 
 and the ratios (scipy's time over ours, > 1: ours is faster):
 
-  x lm           scipy-lm / identify       (the issue's "speedup")
+  x lm           scipy-lm / identify       (the "speedup" asked for)
   x zc           scipy-zc / identify
   int x lm       scipy-lm / identify-int
   x zc-c         scipy-zc-c / identify

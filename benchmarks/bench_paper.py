@@ -8,7 +8,7 @@
   process (``paper.reproduce``) and as the command ``zerocal reproduce``
   (subprocess, includes interpreter start and imports) against ``python -c pass``.
 
-Target (issue 3): ``zerocal reproduce`` finishes well under a minute.
+Target: ``zerocal reproduce`` finishes well under a minute.
 Usage: python benchmarks/bench_paper.py [--repeat N]
 """
 import argparse

@@ -369,13 +369,17 @@ def _json_of(text: str):
 
 
 def json_values(data, path: str):
-    """The values at a dotted path (``a.b[0]``, ``a[*].b``), flattened to a list."""
+    """The values at a dotted path (``a.b[0]``; ``a[*].b`` every element of a list, ``a[0:3].b`` some, ``a.*.b``
+    every value of an object), flattened to a list."""
     items = [data]
-    for tok in re.findall(r"\[(\*|\d+)\]|([^.\[\]]+)", path):
+    for tok in re.findall(r"\[(\*|\d+|\d*:\d*)\]|([^.\[\]]+)", path):
         nxt = []
         for it in items:
-            if tok[0] == "*":
-                nxt += list(it)
+            if tok[0] == "*" or tok[1] == "*":
+                nxt += list(it.values()) if isinstance(it, dict) else list(it)
+            elif ":" in tok[0]:
+                a, b = (int(x) if x else None for x in tok[0].split(":"))
+                nxt += list(it[a:b])
             elif tok[0]:
                 nxt.append(it[int(tok[0])])
             else:
@@ -394,9 +398,10 @@ def _value_words(spec: str):
 
 def check_json(data, line: str):
     """One ``PATH: VALUES`` line against the JSON: ``(None or what differs, [numbers it compares])``."""
-    path, sep, spec = line.partition(":")
-    if not sep:
+    m = re.match(r"\s*(\S+?):\s+(\S.*)$", line)  # the first colon before a blank (a slice's is not)
+    if not m:
         return f"not a 'PATH: VALUES' line: {line!r}", []
+    path, spec = m.groups()
     try:
         vals = json_values(data, path.strip())
     except (KeyError, IndexError, TypeError) as exc:
@@ -450,7 +455,8 @@ def check_text(output: str, patterns: list[str]):
             if why and closest is None:
                 closest = f"{lines[k].strip()!r}: {why}"
         else:
-            return (f"not found after output line {at}: {p!r}" + (f"\n      closest: {closest}" if closest else "")), quoted
+            why = f"not found after output line {at}: {p!r}" + (f"\n      closest: {closest}" if closest else "")
+            return why, quoted
     return None, quoted
 
 

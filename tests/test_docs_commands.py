@@ -84,6 +84,7 @@ def test_a_check_compares_json_values_and_wants_them_in_the_prose():
     assert "0.5219 (page 0.5220)" in dc.check_json(data, "crlb: 0.5220 0.5220")[0]
     assert dc.check_json(data, "groups[*].d: 0.031..0.042") == (None, ["0.031", "0.042"])
     assert dc.check_json(data, "groups[*].d: 0.031..0.041")[0]
+    assert dc.check_json(data, "groups[1:].d: 0.042 0.035")[0] is None and dc.check_json(data, "*: 2.7e-11")[0]
     assert dc.check_json(data, 'method: "nlls"')[0] is None and dc.check_json(data, 'method: "tsvd"')[0]
     assert dc.check_json(data, "err: <1e-10")[0] is None and dc.check_json(data, "err: <1e-11")[0]
     assert "no such value" in dc.check_json(data, "kappa_2: 1")[0]
@@ -102,7 +103,8 @@ def test_a_check_finds_text_patterns_in_order():
 def test_a_stale_page_fails(tmp_path):
     """A page whose console block shows another number than the command prints is reported, line and numbers."""
     page = tmp_path / "p.md"
-    page.write_text("# t\n\n```console\n$ echo 'kappa 1.25'\nkappa 1.4\n$ sh -c 'echo x 2; exit 3'\nx 2\n[exit 3]\n```\n\n"
+    page.write_text("# t\n\n```console\n$ echo 'kappa 1.25'\nkappa 1.4\n$ sh -c 'echo x 2; exit 3'\nx 2\n"
+                    "[exit 3]\n```\n\n"
                     "Ours is 1.25.\n<!-- check: echo 'k 1.251'\nk 1.25\n-->\n\n<!-- check: echo 'k 7'\nk 7\n-->\n")
     parsed = dc.parse_page(page)
     assert [it.kind for it in parsed.items] == ["block", "check", "check"]
@@ -114,7 +116,8 @@ def test_a_stale_page_fails(tmp_path):
 
 def test_unchecked_commands_are_found(tmp_path):
     page = tmp_path / "p.md"
-    page.write_text("```\nzerocal robot\n```\n\n<!-- check-block: not run: your own files -->\n```bash\nzerocal identify "
+    page.write_text("```\nzerocal robot\n```\n\n<!-- check-block: not run: your own files -->\n```bash\n"
+                    "zerocal identify "
                     "mine.csv\n```\n\n```\nzerocal identify: error: d.csv:6: missing\n# zerocal measurements v1\n```\n")
     found = dc.zerocal_lines(dc.parse_page(page))
     assert [(ln, reason, run) for ln, _, reason, run in found] == [(2, None, False), (7, "your own files", False)]

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: c8b9c6693ac6318d
+inputs hash: 4860970f4552cc6d
 sympy: 1.14.0
 """
 import casadi as ca

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: de3321a116718645
+inputs hash: 8ef539e8b47975df
 sympy: 1.14.0
 """
 import casadi as ca

@@ -1,0 +1,68 @@
+"""Commands the docs quote that are too long for the test suite's docs checker: run them and print what they print.
+
+The docs checker (tests/test_docs_commands.py) runs every command a page shows, within the suite's time budget.
+A few figures come from Monte Carlo runs of minutes (many groups, hundreds of trials, several variants); the page
+quotes them from this script's output, with its date and load, and says so.  Each run below prints the command,
+then its output (whole, or the summary a page quotes), then its CPU and wall time.
+
+Usage: python benchmarks/docs_long.py [NAME ...]      (NAME: rules, compare; default both)
+
+* rules (docs/reproduction.md, Decision 3): the TSVD's truncation rules over 100 trials of ``zerocal reproduce``;
+  per run the range over the six groups and two offsets of the mean residual delta and of its standard deviation.
+* compare (docs/nonlinear.md, "Monte Carlo against the CRLB and TSVD"): ``zerocal compare`` with 500 trials on
+  every group of Table 2, and on group 1 without geometric errors, in Table 2's literal frame and with the scale
+  error alone; whole output.
+"""
+import argparse
+import datetime
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+def _delta_ranges(out: str) -> str:
+    groups = json.loads(out)["groups"]
+    delta = [d for g in groups for d in g["delta_deg"]]
+    std = [d for g in groups for d in g["delta_deg_std"]]
+    return (f"mean delta {min(delta):.3f}-{max(delta):.3f} deg, "
+            f"its std over the trials {min(std):.3f}-{max(std):.3f} deg")
+
+
+RUNS = {
+    "rules": [(f"zerocal reproduce --trials 100 --noise {noise} --rule {rule} --json", _delta_ranges)
+              for noise, rule in (("scale-only", "threshold"), ("scale-only", "gcv"), ("scale-only", "discrepancy"),
+                                  ("paper", "threshold"), ("paper", "discrepancy"))],
+    "compare": [(cmd, None) for cmd in ("zerocal compare --trials 500 --all",
+                                        "zerocal compare --trials 500 --group 1 --no-geometric",
+                                        "zerocal compare --trials 500 --group 1 --frame literal",
+                                        "zerocal compare --trials 500 --group 1 --noise scale-only")],
+}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("names", nargs="*", choices=[*RUNS, []], default=list(RUNS), metavar="NAME")
+    a = ap.parse_args()
+    bindir = str(Path(sys.executable).parent)
+    env = dict(os.environ, PATH=bindir + os.pathsep + os.environ.get("PATH", ""))
+    if not shutil.which("zerocal", path=env["PATH"]):
+        sys.exit(f"docs_long.py: no zerocal beside {sys.executable}")
+    for name in a.names or list(RUNS):
+        for cmd, summary in RUNS[name]:
+            load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+            print(f"$ {cmd}\n# {datetime.date.today().isoformat()}, load average {load} on {os.cpu_count()} CPUs",
+                  flush=True)
+            t, c = time.perf_counter(), os.times()
+            r = subprocess.run(cmd, shell=True, env=env, capture_output=True, text=True, check=True)
+            c2 = os.times()
+            cpu = c2.children_user - c.children_user + c2.children_system - c.children_system
+            print(summary(r.stdout) if summary else r.stdout.rstrip())
+            print(f"# CPU {cpu:.1f} s, wall {time.perf_counter() - t:.1f} s\n", flush=True)
+
+
+if __name__ == "__main__":
+    main()
