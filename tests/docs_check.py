@@ -549,6 +549,14 @@ def cpu_seconds(directory: Path) -> list[float]:
     return out
 
 
+def command_key(text: str) -> str:
+    """A command without its trailing ``# comment`` (outside quotes): two spellings of one run."""
+    m = re.search(r"\s+#\s.*$", text)
+    if m and text[:m.start()].count("'") % 2 == 0 and text[:m.start()].count('"') % 2 == 0:
+        return text[:m.start()].strip()
+    return text.strip()
+
+
 def run_page(page: Page, directory: Path):
     """The page's fast items in order in one directory: ``[problem]`` (empty when the page is right)."""
     scratch(directory, page.files)
@@ -558,10 +566,10 @@ def run_page(page: Page, directory: Path):
         if it.slow:
             continue
         for c in it.commands:
-            if it.kind == "check" and c.text in seen:
-                slots.append((it, c, seen[c.text]))
+            if it.kind == "check" and command_key(c.text) in seen:
+                slots.append((it, c, seen[command_key(c.text)]))
                 continue
-            seen.setdefault(c.text, len(todo))
+            seen.setdefault(command_key(c.text), len(todo))
             slots.append((it, c, len(todo)))
             todo.append(c.text)
     results = run_commands(todo, directory) if todo else []
@@ -596,6 +604,18 @@ class SharedCache:
         """A slow item's ``[(status, stdout, stderr)]``, its commands run in a fresh directory."""
         key = "item-" + hashlib.sha256(json.dumps([c.text for c in item.commands]).encode()).hexdigest()[:16]
         return self._once(key, lambda d: run_commands([c.text for c in item.commands], scratch(d, files)))
+
+    def slow_results(self, page: Page, k: int):
+        """The results of the page's slow item ``k``; a slow check of a command a slow block of the page runs
+        takes that block's result (the block is run once, for both)."""
+        item = page.items[k]
+        if item.kind == "check":
+            key = command_key(item.commands[0].text)
+            for other in page.items:
+                keys = [command_key(c.text) for c in other.commands]
+                if other.slow and other.kind == "block" and key in keys:
+                    return [self.results(other, page.files)[keys.index(key)]]
+        return self.results(item, page.files)
 
     def page(self, page: Page):
         """``(directory, problems)`` of the page's fast items, run in order in ``directory``."""

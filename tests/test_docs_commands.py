@@ -29,7 +29,7 @@ def test_page_prints_what_it_shows(name, docs_runs):
 def test_slow_item_prints_what_the_page_shows(name, k, docs_runs):
     page = PAGES[name]
     item = page.items[k]
-    problems = dc.judge_item(item, docs_runs.results(item, page.files))
+    problems = dc.judge_item(item, docs_runs.slow_results(page, k))
     assert not problems, "\n".join(problems)
 
 
@@ -112,6 +112,17 @@ def test_a_stale_page_fails(tmp_path):
     assert len(problems) == 1 + 1 and "which the section's text does not show" in problems[1]
     page.write_text(page.read_text().replace("kappa 1.4", "kappa 1.1"))
     assert "1.25 where the page shows 1.1" in dc.run_page(dc.parse_page(page), tmp_path / "run2")[0]
+
+
+def test_a_check_reuses_a_block_run_of_its_command(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("# t\n\n```bash\necho $RANDOM > n.txt; cat n.txt   # once\n```\n\n"
+                    "It printed a number below 100000.\n<!-- check: echo $RANDOM > n.txt; cat n.txt\n{<100000}\n-->\n")
+    parsed = dc.parse_page(page)
+    assert dc.command_key(parsed.items[0].commands[0].text) == parsed.items[1].commands[0].text
+    assert dc.run_page(parsed, tmp_path / "run") == []
+    ran = tmp_path / "run" / ".docs-check"
+    assert (ran / "0.out").exists() and not (ran / "1.out").exists()  # the check took the block's output
 
 
 def test_unchecked_commands_are_found(tmp_path):
