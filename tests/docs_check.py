@@ -58,9 +58,9 @@ NUMBER = r"(?<![\w.])(?<![\w.][-+])[-+]?(?:\d+(?:\.\d+)?|\.\d+)(?:[eE][-+]?\d+)?
 ANY_NUMBER = r"([-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?)"
 BOUND = r"\{(<=?)\s*(" + NUMBER[len(r"(?<![\w.])(?<![\w.][-+])"):] + r")\}"
 MINUS = "\u2212"
-FENCE = re.compile(r"^(```+|~~~+)\s*([\w+-]*)\s*$")
+FENCE = re.compile(r"^( {0,3})(```+|~~~+)\s*([\w+-]*)\s*$")
 CHECK_OPEN = re.compile(r"^<!--\s*check(\s+slow)?:\s*(.*)$")
-BLOCK_DIRECTIVE = re.compile(r"^<!--\s*check-block:\s*(.*?)\s*-->\s*$")
+BLOCK_DIRECTIVE = re.compile(r"^\s*<!--\s*check-block:\s*(.*?)\s*-->\s*$")
 RUN_LANGS = {"console", "bash", "sh", "shell"}
 
 
@@ -109,11 +109,11 @@ def parse_page(path: Path) -> Page:
         ln = lines[i]
         m = FENCE.match(ln)
         if m:
-            fence, lang, start = m.group(1), m.group(2).lower(), i + 1
+            indent, fence, lang, start = len(m.group(1)), m.group(2), m.group(3).lower(), i + 1
             j = start
-            while j < len(lines) and not lines[j].startswith(fence[:3]):
+            while j < len(lines) and not lines[j].strip().startswith(fence[:3]):
                 j += 1
-            body = lines[start:j]
+            body = [ln[indent:] if ln[:indent].isspace() else ln for ln in lines[start:j]]
             words = (directive or "").split(None, 1)
             reason = directive.split(":", 1)[1].strip() if directive and directive.startswith("not run") else None
             fenced.append((start, lang, "\n".join(body), reason))
@@ -601,20 +601,25 @@ class SharedCache:
             return json.loads(path.read_text())
 
     def results(self, item: Item, files):
-        """A slow item's ``[(status, stdout, stderr)]``, its commands run in a fresh directory."""
+        """A slow item's ``[(status, stdout, stderr)]``, its commands run in a fresh directory; the lines of a
+        slow bash block each in one of their own (they must not depend on each other), so that a check of one
+        of them, on any page, takes its run."""
+        if len(item.commands) == 1 or (item.kind == "block" and all(c.expected is None for c in item.commands)):
+            return [self.command(c.text, files) for c in item.commands]
         key = "item-" + hashlib.sha256(json.dumps([c.text for c in item.commands]).encode()).hexdigest()[:16]
         return self._once(key, lambda d: run_commands([c.text for c in item.commands], scratch(d, files)))
 
+    def command(self, text: str, files=None):
+        """One command's ``(status, stdout, stderr)``, run in a fresh directory (once per session)."""
+        key = "cmd-" + hashlib.sha256(command_key(text).encode()).hexdigest()[:16]
+        return self._once(key, lambda d: run_commands([text], scratch(d, files))[0])
+
     def slow_results(self, page: Page, k: int):
-        """The results of the page's slow item ``k``; a slow check of a command a slow block of the page runs
-        takes that block's result (the block is run once, for both)."""
+        """The results of the page's slow item ``k``: a slow check's command, and each line of a slow bash block,
+        run once per session for every page and check that names it."""
         item = page.items[k]
         if item.kind == "check":
-            key = command_key(item.commands[0].text)
-            for other in page.items:
-                keys = [command_key(c.text) for c in other.commands]
-                if other.slow and other.kind == "block" and key in keys:
-                    return [self.results(other, page.files)[keys.index(key)]]
+            return [self.command(item.commands[0].text, page.files)]
         return self.results(item, page.files)
 
     def page(self, page: Page):
