@@ -143,6 +143,8 @@ def parse_page(path: Path) -> Page:
                 raise ValueError(f"{_rel(path)}:{start}: a check states what it compares on the lines "
                                  "after its command, and ends with --> on a line of its own")
             while j < len(lines) and lines[j].strip() != "-->":
+                if "-->" in lines[j]:
+                    raise ValueError(f"{_rel(path)}:{j + 1}: a check comment ends with --> on a line of its own")
                 body.append(lines[j])
                 j += 1
             if j == len(lines):

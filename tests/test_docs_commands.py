@@ -143,7 +143,8 @@ def test_the_pages_parse(tmp_path):
     bad.write_text("<!-- check-block: fast -->\n```console\n$ true\n```\n")
     with pytest.raises(ValueError, match="unknown check-block directive"):
         dc.parse_page(bad)
-    bad.write_text("<!-- check: zerocal robot -->\n")
-    with pytest.raises(ValueError, match="ends with --> on a line of its own"):
-        dc.parse_page(bad)
+    for text in ("<!-- check: zerocal robot -->\n", "<!-- check: zerocal robot\nhome P0\n--> and prose\n"):
+        bad.write_text(text)
+        with pytest.raises(ValueError, match="ends with --> on a line of its own"):
+            dc.parse_page(bad)
     assert Path(dc.ROOT / "README.md") in dc.PAGES
