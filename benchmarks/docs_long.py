@@ -45,8 +45,11 @@ RUNS = {
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("names", nargs="*", choices=[*RUNS, []], default=list(RUNS), metavar="NAME")
+    ap.add_argument("names", nargs="*", metavar="NAME", help=f"which runs: {', '.join(RUNS)} (default: all)")
     a = ap.parse_args()
+    unknown = [n for n in a.names if n not in RUNS]
+    if unknown:
+        ap.error(f"unknown run(s) {', '.join(unknown)}: the runs are {', '.join(RUNS)}")
     bindir = str(Path(sys.executable).parent)
     env = dict(os.environ, PATH=bindir + os.pathsep + os.environ.get("PATH", ""))
     if not shutil.which("zerocal", path=env["PATH"]):
