@@ -5,7 +5,8 @@ The convention (README.md, "Development", "Docs that run") in short:
 * A fenced block tagged ``console`` holds commands (lines starting with ``$ ``, continued by a trailing ``\\``)
   each followed by what it prints on stdout.  The output must match line by line: a line ``...`` skips any
   number of lines, ``...`` inside a line any text, a run of blanks any run of blanks, and a number matches when
-  the printed one equals it to the digits shown (``0.4910`` admits [0.49095, 0.49105]).  A last line
+  the printed one equals it to the digits shown (``0.4910`` admits [0.49095, 0.49105]), or, right before
+  ``...``, when the printed one starts with its digits (``-1.9540068...``).  A last line
   ``[exit N]`` says the command exits with status N (else 0 is required).
 * A fenced block tagged ``bash`` (or ``sh``) is run line by line; each command must exit 0, its output is not
   compared (the block shows none).
@@ -20,12 +21,14 @@ The convention (README.md, "Development", "Docs that run") in short:
       crlb_zero_offsets_deg: 0.522 0.522
       -->
 
-  ``<!-- check slow: ...`` for a command too long for the fast tests.  When the command prints JSON (from its
+  ``<!-- check slow: ...`` for a command too long for the fast tests (run once per session in a fresh directory,
+  whichever pages show it; so is each line of a slow bash block).  When the command prints JSON (from its
   first line starting with ``{``), each line is ``PATH: VALUES``: PATH a dotted key path (``a.b[0]``, ``[*]`` for
-  every element of a list), VALUES numbers compared at their digits with the values there (flattened, in order),
-  ``LO..HI`` (the smallest and the largest value, at the digits shown), ``<X`` or ``<=X`` (every value), or a
-  quoted string.  Otherwise each line is a pattern like a console output line, found in the output in order
-  (a part of a line, each on a later line than the one before); ``{<X}`` / ``{<=X}`` in a pattern is a number
+  every element of a list, ``[0:3]`` some, ``.*`` every value of an object), VALUES numbers compared at their
+  digits with the values there (flattened, in order), ``LO..HI`` (the smallest and the largest value, at the
+  digits shown), ``<X`` or ``<=X`` (every value), or a quoted string.  Otherwise each line is a pattern like a
+  console output line, found in the output in order (a part of a line, each on a later line than the one
+  before); ``{<X}`` / ``{<=X}`` in a pattern is a number
   that must be below X.  Every number a check compares must also appear in the page's text of the same section
   (from the heading before it to the comment), so that the prose and the check cannot drift apart.
 
