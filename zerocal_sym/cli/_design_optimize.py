@@ -403,6 +403,9 @@ def _run_target(args, robot):
            "bound": "no design of fewer than K_lower_bound poses on the candidate poses reaches the target "
                     "(certificate of the optimal design measure); K is the fewest poses of the rounded designs",
            "time_s": res["time_s"]}
+    from zerocal_sym.design.replicates import revisits_entry
+
+    out.update(revisits_entry(P))  # true replicates: a pose file of the design says revisits are intended
     from zerocal_sym.identify import fisher
 
     out[k("crlb_zero_offsets")] = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise).tolist()
@@ -420,6 +423,9 @@ def _run_target(args, robot):
           f"region {region_text(cons.region)}")
     print(f"  K = {out['K']} (design CRLB {out[k('crlb_rms')]:.5g} {ju}; per offset "
           f"{', '.join(f'{v:.5g}' for v in out[k('crlb_zero_offsets')])})")
+    if out.get("revisits"):
+        print(f"  the poses are replicates of {len(np.unique(P, axis=0))} support points, never one twice in a row "
+              "(the JSON says \"revisits\": \"allowed\": its readers accept them)")
     print(f"  certified: no design of fewer than {out['K_lower_bound']} poses on the "
           f"{out['approximate']['n_candidates']} candidate poses can reach it")
     a = out["approximate"]

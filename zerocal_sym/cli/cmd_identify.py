@@ -79,6 +79,9 @@ def add_arguments(p):
                         f"{SIGMA_FRACTION:g} x the largest |offset|)")
     p.add_argument("--goal-deg", type=float, default=None, metavar="DEG",
                    help="the same for revolute joints, in deg")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the measurement file")
     p.add_argument("--json", action="store_true", help="print the results JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="write the results JSON here")
     p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
@@ -275,7 +278,7 @@ def run(args):
     robot = load_robot_arg(args)
     errors = robot.errors
     prior = maemm_prior_vector(robot, args.maemm_prior)
-    meas = load_measurements(args.data, robot)  # refuses data of another mechanism or robot (robot_sha256)
+    meas = load_measurements(args.data, robot, allow_revisits=args.allow_revisits)  # refuses data of another mechanism or robot (robot_sha256)
     noise = NoiseModel.named(args.noise, robot)
     from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
 

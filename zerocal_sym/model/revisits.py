@@ -1,7 +1,21 @@
-"""The first row of an array that repeats an earlier one within a tolerance (:func:`first_duplicate`).
+"""Revisited poses: rows of an array that repeat an earlier one, and the groups of visits of one pose.
 
-Used for repeated poses in a measurement file
-(:mod:`zerocal_sym.io.measurement_checks`) and in a pose list.
+A measurement round may visit a pose more than once (a *revisit*: the same
+commanded joints, to :data:`REVISIT_TOL` in their file unit).  A revisit right
+after the first visit (a *consecutive repeat*) measures a zero change and
+carries no information; any other revisit is legitimate (a design's
+replicates) when the file or the user says revisits are intended
+(:mod:`zerocal_sym.io.measurement_checks`).
+
+* :func:`first_duplicate` -- the first row that repeats an earlier one;
+* :func:`consecutive_repeat` -- the first row that repeats the row before it;
+* :func:`pose_groups` -- the visits of each pose: a label per row, the
+  revisited poses' groups;
+* :func:`shared_design` -- the shared (revisit) part of the distance
+  covariance: which visits share a pose's systematic error
+  (:mod:`zerocal_sym.identify.covariance`).
+
+Shapes: K rows (poses), d columns.
 """
 from __future__ import annotations
 
@@ -80,3 +94,64 @@ def first_duplicate(X, tol: float):
         return None
     dist = np.max(np.abs(X[:best] - X[best]), axis=1)
     return best, int(np.argmin(dist))
+
+
+#: two poses whose coordinates (commanded joints in their file unit: deg or mm; or targets in mm) agree to this
+#: are the same pose
+REVISIT_TOL = 1e-9
+
+
+def consecutive_repeat(X, tol: float = REVISIT_TOL):
+    """The first row ``k`` within ``tol`` of row ``k - 1`` in every column (a zero change), or None."""
+    X = np.asarray(X, float)
+    if X.ndim == 1:
+        X = X[:, None]
+    if X.shape[0] < 2:
+        return None
+    with np.errstate(invalid="ignore"):
+        same = np.all(np.abs(np.diff(X, axis=0)) <= tol, axis=1)
+    hit = np.flatnonzero(same)
+    return int(hit[0]) + 1 if hit.size else None
+
+
+def pose_groups(X, tol: float = REVISIT_TOL) -> np.ndarray:
+    """The pose of each row: label ``g`` (0, 1, ... in order of first visit), shape (K,).
+
+    Rows within ``tol`` of each other in every column are one pose (exact
+    copies first, then any near copies merged: O(K log K) when there are
+    none); ``tol = 0``: exact copies only.
+    """
+    X = np.asarray(X, float)
+    if X.ndim == 1:
+        X = X[:, None]
+    K = X.shape[0]
+    if K == 0:
+        return np.zeros(0, int)
+    _, first, inv = np.unique(X, axis=0, return_index=True, return_inverse=True)
+    inv = np.ravel(inv)
+    rep = np.sort(first)                      # one row per distinct pose, in order of first visit
+    label_of_unique = np.empty(len(first), int)
+    label_of_unique[np.argsort(first)] = np.arange(len(first))
+    lab = label_of_unique[inv]
+    # near copies (within tol, not equal): merge them into the earlier pose
+    while tol > 0 and len(rep) > 1:
+        dup = first_duplicate(X[rep], tol)
+        if dup is None:
+            break
+        k, j = dup
+        lab[lab == k] = j
+        lab[lab > k] -= 1
+        rep = np.delete(rep, k)
+    return lab
+
+
+def shared_design(labels) -> tuple:
+    """``(singles, groups)`` of a pose labelling: the rows of poses visited once (bool (K,)) and the rows of
+    each revisited pose (a list of index arrays, each of two or more rows, in order of first visit)."""
+    lab = np.asarray(labels, int)
+    counts = np.bincount(lab) if lab.size else np.zeros(0, int)
+    singles = counts[lab] == 1
+    order = np.argsort(lab, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    groups = [order[starts[g]:starts[g + 1]] for g in np.flatnonzero(counts >= 2)]
+    return singles, groups
