@@ -405,6 +405,10 @@ def run(args):
     if res.method == "nlls":
         print(f"Ipopt: {info['solver_status']}, {info['iterations']} iterations, cost {info['cost']:.6g}, "
               f"chi2 {info['chi2']:.4g} on {info['dof']} dof; weights: {info['weighting']}")
+    if "revisits" in info:
+        from zerocal_sym.identify.revisits import describe
+
+        print(describe(info["revisits"]))
     if args.report:
         print(format_report(report))
     if args.out:

@@ -118,3 +118,30 @@ def shared_fisher(aq, v, sm2, B):
         return np.zeros((A.shape[1], A.shape[1]))  # not positive definite: no information (rank-deficient)
     F = WA.T @ WA
     return (F + F.T) / 2
+
+
+def shared_floor(robot, support, noise) -> float:
+    """The RMS zero-offset CRLB (file unit) that replicates of ``support`` (s, n) approach as K grows, with the
+    shared revisit error: every support point's own ``u_g`` stays, the independent errors average out::
+
+        F_inf = sum_g (a_g - mean a)(a_g - mean a)^T / sigma_r^2
+
+    (``a_g`` the distance's sensitivity at support point g; the mean: the changes do not see a common
+    offset).  ``inf`` when the support cannot identify the parameters; 0 without a shared error.
+    """
+    from zerocal_sym.design.terms import offset_positions, offsets_to_user
+    from zerocal_sym.model import kinematics as kin
+
+    if not noise.has_shared:
+        return 0.0
+    _, de, _ = kin.distance_jacobians(robot, kin.ik(robot, np.atleast_2d(support)))
+    a = de[:, robot.errors.indices("paper")]
+    a = a - a.mean(axis=0)
+    F = a.T @ a / noise.sigma_revisit_mm**2
+    try:
+        var = np.diag(np.linalg.inv(F))[offset_positions(robot)]
+    except np.linalg.LinAlgError:
+        return float("inf")
+    if not np.all(np.isfinite(var)) or np.any(var <= 0):
+        return float("inf")
+    return float(np.sqrt(np.mean(np.square(offsets_to_user(robot, np.sqrt(var))))))

@@ -46,7 +46,7 @@ import time
 import numpy as np
 
 from zerocal_sym.identify import fisher, fitcheck
-from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear
+from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear, _noise_dict
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, initial, prior_whitener,
                                              scaled_bounds)
@@ -169,6 +169,9 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             raise ValueError(f"loss_scale must be positive, got {loss_scale!r}")
         if bounds is not None:
             raise ValueError("a robust loss does not take bounds")
+        if noise.has_shared:
+            raise ValueError("a robust loss does not take a shared revisit error (the noise model's "
+                             "sigma_revisit_mm, [noise] revisit_std_mm): use loss 'l2'")
     errors = robot.errors
     names = errors.resolve(params)
     theta_cmd, readings = check_measurements(robot, meas)
@@ -186,6 +189,12 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     z0 = x0 * scale if bounds is None else np.clip(x0 * scale, lbx, ubx)  # (clipping to +-inf: no-op)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
     sol = solve(prob, z0, par, reweight, bounds is not None, lbx, ubx, max_iter, K)
+    sol.cov = sol.A = None
+    if noise.has_shared and not noise.is_zero:  # the full covariance (not tridiagonal): on from the banded fit
+        from zerocal_sym.identify.nlls_shared import revisit_stage
+
+        revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale, K,
+                      *((lbx, ubx) if bounds is not None else ()))
     robust = A = None
     robust_failed = None
     if loss != "l2":
@@ -209,8 +218,10 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "dof": (K - 1) - len(names),
         "time_s": None,
         "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
-                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"),
-        "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
+                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"
+                      + ("; the revisits' shared error by the full covariance (Gauss-Newton from the banded "
+                         "fit)" if sol.cov is not None else "")),
+        "noise": _noise_dict(noise),
         "warm_start": start,
         "gauss_newton": {"converged": sol.gn_ok, "last_step_mm": sol.step},
         "initial": x0.tolist(),
@@ -233,11 +244,11 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     rows = np.flatnonzero(np.any(w != 0, axis=1))
     if robust is None:
         terms = None
-        if not rows.size and rank == len(names) and "fit_terms" in prob.fast:  # the per-reading terms, O(K p)
-            terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]
+        if not rows.size and rank == len(names) and "fit_terms" in prob.fast and sol.cov is None:
+            terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]  # the per-reading terms, O(K p)
         lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
                       np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
-                      (l, b), np.arange(1, K), s - pred, np.eye(len(names)),
+                      (l, b) if sol.cov is None else sol.cov, np.arange(1, K), s - pred, np.eye(len(names)),
                       scale, names, len(rows),
                       svd=None if rows.size else svd,  # no prior rows: J's SVD is Jd's
                       terms=terms)
@@ -255,8 +266,25 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                           prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     if robust is not None:
         _limit_outliers(res, robust, loss, K, accept_misfit)
+    _revisits(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)
     info["time_s"] = time.perf_counter() - t0
     return res
+
+
+def _revisits(res, robot, theta_cmd, e, sol, A, K, noise, names, prior_q, scale):
+    """``info["revisits"]``: the round's revisits and the REML estimate of their shared error (when it has
+    any; :func:`zerocal_sym.identify.revisits.revisit_report`)."""
+    from zerocal_sym.identify.nlls_shared import pred_jacobian
+    from zerocal_sym.identify.revisits import revisit_report
+
+    if A is None:
+        A = sol.A if sol.A is not None else pred_jacobian(sol.l, sol.b, sol.J, K)
+    try:
+        rep = revisit_report(robot, theta_cmd, e, A, noise, robot.errors.put(prior_q, names, sol.z / scale))
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+        rep = {"reason": f"not estimated: {exc}"}
+    if rep is not None:
+        res.info["revisits"] = rep
 
 
 def _limit_outliers(res, robust, loss, K, accept_misfit):
@@ -350,6 +378,9 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
         ``p = z / scale`` (physical units); start at ``prior[params] * scale``.
     """
     noise = NoiseModel.coerce(noise, robot=robot)
+    if noise.has_shared:
+        raise ValueError("residual_problem is the banded problem: a noise model with the shared revisit error "
+                         "(sigma_revisit_mm) has more than the bands (identify_nlls fits it)")
     errors = robot.errors
     names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
