@@ -29,7 +29,9 @@ readings scatter beyond the independent noise, with the r parameters
 fitted: a handful of revisited poses (a design's support points) leave few
 degrees of freedom, and the interval is wide (it says so).
 
-Each evaluation of ``l`` is O(K (r + G)); about a hundred are made.
+Each evaluation of ``l`` is O(G r^2) after an O(K P) start when the round has at most
+:data:`MAX_POSES_LOW_RANK` distinct poses P (every pose's error in the low-rank part: the bands are the
+same for every ``s``), O(K (r + G)) otherwise; about a hundred are made.
 """
 from __future__ import annotations
 
@@ -43,23 +45,55 @@ from zerocal_sym.identify.covariance import ChangeCovariance
 #: 2 (l_max - l) at the edge of the 95 % profile interval (chi2 with 1 dof)
 CHI2_95 = 3.841458820694124
 #: grid points of the first search (geometric, below the largest value tried)
-GRID = 48
+GRID = 24
 
 
-def _restricted_loglik(sm2, v, labels, X, e, s):
-    """``l(s)`` (module docstring), ``-inf`` where C is not positive definite."""
-    C = ChangeCovariance.from_variances(math.sqrt(sm2), v, labels, s)
+#: a round of at most this many distinct poses puts every pose's shared error in the low-rank part: the bands
+#: are then the same for every sigma_r, factored once, and each evaluation of the likelihood is O(G p^2)
+MAX_POSES_LOW_RANK = 200
+
+
+def _gram_loglik(logdet, M):
+    """``l`` from ``log det C`` and the Gram matrix ``M = [X e]^T C^-1 [X e]`` ((r+1) x (r+1))."""
     try:
-        Xw, ew = C.whiten(X), C.whiten(e)
-        logdet = C.logdet()
+        Lx = np.linalg.cholesky(M[:-1, :-1])
     except np.linalg.LinAlgError:
         return -math.inf
-    Q, R = np.linalg.qr(Xw)
-    d = np.abs(np.diag(R))
-    if not np.all(d > 0):
-        return -math.inf
-    q = float(ew @ ew) - float(np.sum((Q.T @ ew) ** 2))
-    return -0.5 * (logdet + 2.0 * float(np.sum(np.log(d))) + q)
+    u = np.linalg.solve(Lx, M[:-1, -1])
+    return -0.5 * (logdet + 2.0 * float(np.sum(np.log(np.diag(Lx)))) + float(M[-1, -1] - u @ u))
+
+
+def _likelihood(sm2, v, labels, X, e):
+    """``s -> l(s)`` (module docstring), ``-inf`` where C is not positive definite."""
+    Y = np.column_stack([X, e])
+    P = int(labels.max()) + 1
+    if P <= MAX_POSES_LOW_RANK:  # every pose's error in the low-rank part: the bands do not depend on s
+        C0 = ChangeCovariance.from_variances(math.sqrt(sm2), v)
+        l, b = C0.cholesky()
+        W1 = C0.whiten(np.diff(np.eye(P)[labels], axis=0))      # L^-1 D Z, per unit sigma_r
+        lam1, V = np.linalg.eigh(W1.T @ W1)
+        keep = lam1 > 1e-14 * max(float(lam1.max(initial=0.0)), 1e-300)
+        lam1 = lam1[keep]
+        Q = (W1 @ V[:, keep]) / np.sqrt(lam1)
+        Yw = C0.whiten(Y)
+        G0, Qy = Yw.T @ Yw, Q.T @ Yw
+        ld0 = 2.0 * float(np.sum(np.log(l)))
+
+        def f(s):
+            lam = s * s * lam1
+            M = G0 + Qy.T @ ((1.0 / (1.0 + lam) - 1.0)[:, None] * Qy)
+            return _gram_loglik(ld0 + float(np.sum(np.log1p(lam))), M)
+        return f
+
+    def f(s):
+        C = ChangeCovariance.from_variances(math.sqrt(sm2), v, labels, s)
+        try:
+            Yw = C.whiten(Y)
+            logdet = C.logdet()
+        except np.linalg.LinAlgError:
+            return -math.inf
+        return _gram_loglik(logdet, Yw.T @ Yw)
+    return f
 
 
 def reml_revisit_std(e, X, sm2, v, labels) -> dict:
@@ -91,7 +125,7 @@ def reml_revisit_std(e, X, sm2, v, labels) -> dict:
     X = np.atleast_2d(np.asarray(X, float))
     U, sv, _ = np.linalg.svd(X, full_matrices=False)
     X = U[:, : int(np.sum(sv > 1e-10 * (sv[0] if sv.size else 0.0)))]  # the identified combinations
-    f = lambda s: _restricted_loglik(sm2, v, labels, X, e, s)  # noqa: E731
+    f = _likelihood(sm2, v, np.asarray(labels, int), X, e)
     scale = math.sqrt(max(float(np.mean(e * e)), sm2, 1e-30))
     grid = np.concatenate([[0.0], scale * np.geomspace(1e-4, 10.0, GRID)])
     vals = np.array([f(s) for s in grid])
@@ -121,7 +155,7 @@ def _edge(f, target, a, b):
     """The point between ``a`` and ``b`` where ``f`` crosses ``target`` (f(a), f(b) on either side)."""
     from scipy.optimize import brentq
 
-    return float(brentq(lambda s: f(s) - target, a, b, xtol=1e-9 * max(b, 1e-12)))
+    return float(brentq(lambda s: f(s) - target, a, b, xtol=1e-6 * max(b, 1e-12)))
 
 
 def revisit_report(robot, theta_cmd, e, A, noise, err0=None) -> dict | None:
