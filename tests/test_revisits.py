@@ -217,6 +217,16 @@ def test_target_crlb_is_within_two_percent_of_its_bound(capsys, tmp_path):
     assert main(["identify", str(data), "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["success"] and res["revisits"]["visits"] == d["K"] - 2  # two support points visited once
+    # compare and a study's spec read the design's poses as rounds
+    assert main(["compare", "--poses", str(out), "--set", "theta1=0.5", "--trials", "2", "--methods", "tsvd",
+                 "--quiet", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)
+    from zerocal_sym.cli.study_spec import load_spec
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(f'name = "r"\ntrials = 2\nrobots = ["paper"]\n[[design]]\nposes = "{out.name}"\n'
+                    '[[truth]]\nname = "t"\ntheta1 = 0.5\n')
+    assert load_spec(spec) is not None
 
 
 # ----------------------------------------------------------------- the loaders
