@@ -280,6 +280,10 @@ def run(args):
     prior = maemm_prior_vector(robot, args.maemm_prior)
     meas = load_measurements(args.data, robot, allow_revisits=args.allow_revisits)  # refuses data of another mechanism or robot (robot_sha256)
     noise = NoiseModel.named(args.noise, robot)
+    if args.loss not in (None, "l2") and noise.has_shared:
+        raise ZerocalError(f"--loss {args.loss}: a robust loss does not take the robot file's shared revisit error "
+                           f"([noise] revisit_std_mm = {noise.sigma_revisit_mm:g}): use --loss l2, or --noise "
+                           "scale-only / servo-only")
     from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
 
     try:  # the tolerances of the errors left out, checked before any work

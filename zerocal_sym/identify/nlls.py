@@ -266,25 +266,11 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                           prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     if robust is not None:
         _limit_outliers(res, robust, loss, K, accept_misfit)
-    _revisits(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)
+    from zerocal_sym.identify.nlls_shared import revisits_entry
+
+    revisits_entry(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)
     info["time_s"] = time.perf_counter() - t0
     return res
-
-
-def _revisits(res, robot, theta_cmd, e, sol, A, K, noise, names, prior_q, scale):
-    """``info["revisits"]``: the round's revisits and the REML estimate of their shared error (when it has
-    any; :func:`zerocal_sym.identify.revisits.revisit_report`)."""
-    from zerocal_sym.identify.nlls_shared import pred_jacobian
-    from zerocal_sym.identify.revisits import revisit_report
-
-    if A is None:
-        A = sol.A if sol.A is not None else pred_jacobian(sol.l, sol.b, sol.J, K)
-    try:
-        rep = revisit_report(robot, theta_cmd, e, A, noise, robot.errors.put(prior_q, names, sol.z / scale))
-    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
-        rep = {"reason": f"not estimated: {exc}"}
-    if rep is not None:
-        res.info["revisits"] = rep
 
 
 def _limit_outliers(res, robust, loss, K, accept_misfit):
@@ -362,7 +348,9 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
 
     For outside solvers (``scipy.optimize.least_squares``) on exactly the
     problem Ipopt solves with ``warm_start=None, reweight=0`` (weights at
-    ``prior``, no bounds, no Gaussian prior).
+    ``prior``, no bounds, no Gaussian prior); with the shared revisit error
+    whitened by the full covariance at ``prior`` (the problem
+    :func:`identify_nlls` goes on to).
 
     ``callbacks``: ``"plain"`` calls the CasADi Functions the ordinary way
     (numpy converted in and out); ``"fast"`` through zero-copy buffers
@@ -378,9 +366,6 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
         ``p = z / scale`` (physical units); start at ``prior[params] * scale``.
     """
     noise = NoiseModel.coerce(noise, robot=robot)
-    if noise.has_shared:
-        raise ValueError("residual_problem is the banded problem: a noise model with the shared revisit error "
-                         "(sigma_revisit_mm) has more than the bands (identify_nlls fits it)")
     errors = robot.errors
     names = errors.resolve(params)
     theta_cmd = np.atleast_2d(np.asarray(meas.theta_cmd, float))
@@ -391,10 +376,19 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
                     errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
     fs = prob.functions
     l, b = (o.full().ravel() for o in fs["weights"](errors.take(prior_q, names) * scale, par))
+    if callbacks not in ("plain", "fast"):
+        raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
     if callbacks == "fast":
         rfun, jfun = FastCall(fs["rfun"]), FastCall(fs["jfun"])
-        return (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy()), scale
-    if callbacks != "plain":
-        raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
-    rfun, jfun = fs["rfun"], fs["jfun"]
-    return (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full()), scale
+        fun, jac = (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy())
+    else:
+        rfun, jfun = fs["rfun"], fs["jfun"]
+        fun, jac = (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full())
+    if noise.has_shared and not noise.is_zero:  # the full covariance at the prior: W L0 (L0 r = the residuals)
+        from zerocal_sym.identify import banded
+
+        C = fisher.change_covariance(robot, theta_cmd, noise, prior_q)
+        return ((lambda z: C.whiten(banded.times_factor(l, b, fun(z)))),
+                (lambda z: C.whiten(banded.times_factor(l, b, np.reshape(jac(z), (theta_cmd.shape[0] - 1, -1))))),
+                scale)
+    return fun, jac, scale

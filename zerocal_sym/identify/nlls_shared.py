@@ -12,7 +12,8 @@ whitened problem at its end: residuals, Jacobian (prior rows kept) and the
 covariance, for the information and the fit check.
 
 :func:`revisit_stage` -- the stage; :func:`pred_jacobian` -- ``d pred / d z``
-from the banded problem's whitened Jacobian.
+from the banded problem's whitened Jacobian; :func:`revisits_entry` -- a
+result's ``info["revisits"]`` (:mod:`zerocal_sym.identify.revisits`).
 """
 from __future__ import annotations
 
@@ -72,3 +73,18 @@ def revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale
         sol.ret = (f"{sol.ret}; the fit with the revisits' shared error (Gauss-Newton, full covariance) did not "
                    f"converge in {MAX_ITER} steps")
     return sol
+
+
+def revisits_entry(res, robot, theta_cmd, e, sol, A, K, noise, names, prior_q, scale):
+    """``info["revisits"]``: the round's revisits and the REML estimate of their shared error (when it has
+    any; :func:`zerocal_sym.identify.revisits.revisit_report`)."""
+    from zerocal_sym.identify.revisits import revisit_report
+
+    if A is None:
+        A = sol.A if sol.A is not None else pred_jacobian(sol.l, sol.b, sol.J, K)
+    try:
+        rep = revisit_report(robot, theta_cmd, e, A, noise, robot.errors.put(prior_q, names, sol.z / scale))
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+        rep = {"reason": f"not estimated: {exc}"}
+    if rep is not None:
+        res.info["revisits"] = rep

@@ -200,6 +200,8 @@ def revisit_report(robot, theta_cmd, e, A, noise, err0=None) -> dict | None:
 
 def describe(rep: dict) -> str:
     """One line for the text output."""
+    if "revisited_poses" not in rep:
+        return f"revisits: their shared error {rep.get('reason')}"
     head = (f"revisits: {rep['revisited_poses']} of {rep['poses']} poses visited more than once "
             f"({rep['visits']} visits)")
     if "estimate_mm" not in rep:
