@@ -8,7 +8,6 @@ besides), the CRLB of the realised design at K = 50 ... 3200 and the floor its r
 
 Usage: python benchmarks/replicates.py
 """
-import numpy as np
 
 from zerocal_sym import design
 from zerocal_sym.design import approx, rounding

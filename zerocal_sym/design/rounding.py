@@ -13,7 +13,6 @@ holds between distinct poses: a replicate is the support point itself.
 from __future__ import annotations
 
 import itertools
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
