@@ -78,8 +78,10 @@ def revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale
 def revisits_entry(res, robot, theta_cmd, e, sol, A, K, noise, names, prior_q, scale):
     """``info["revisits"]``: the round's revisits and the REML estimate of their shared error (when it has
     any; :func:`zerocal_sym.identify.revisits.revisit_report`)."""
-    from zerocal_sym.identify.revisits import revisit_report
+    from zerocal_sym.identify.revisits import has_revisits, revisit_report
 
+    if not has_revisits(robot, theta_cmd):
+        return
     if A is None:
         A = sol.A if sol.A is not None else pred_jacobian(sol.l, sol.b, sol.J, K)
     try:

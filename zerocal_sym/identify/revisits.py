@@ -158,6 +158,14 @@ def _edge(f, target, a, b):
     return float(brentq(lambda s: f(s) - target, a, b, xtol=1e-6 * max(b, 1e-12)))
 
 
+def has_revisits(robot, theta_cmd) -> bool:
+    """Whether the round visits a pose more than once (O(K log K))."""
+    from zerocal_sym.identify.fisher import pose_labels
+
+    lab = pose_labels(robot, theta_cmd)
+    return bool(lab.size) and int(lab.max()) + 1 < lab.size
+
+
 def revisit_report(robot, theta_cmd, e, A, noise, err0=None) -> dict | None:
     """The round's revisits and the REML estimate of their shared error (None: no pose is revisited).
 

@@ -252,8 +252,10 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
 def _revisits(res, robot, th, exact, z):
     """``info["revisits"]`` when the round revisits a pose (:func:`zerocal_sym.identify.revisits.revisit_report`,
     at the fit check's point)."""
-    from zerocal_sym.identify.revisits import revisit_report
+    from zerocal_sym.identify.revisits import has_revisits, revisit_report
 
+    if not has_revisits(robot, th):
+        return
     try:
         e, A = exact.raw(z)
         rep = revisit_report(robot, th, e, A, exact.noise, exact.robot.errors.put(exact.prior_q, exact.names,
