@@ -214,9 +214,17 @@ def test_target_crlb_is_within_two_percent_of_its_bound(capsys, tmp_path):
                  "--out", str(data)]) == 0
     assert "# revisits: allowed" in data.read_text()
     capsys.readouterr()
-    assert main(["identify", str(data), "--json"]) == 0
+    result = tmp_path / "r.json"
+    assert main(["identify", str(data), "--json", "--out", str(result)]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["success"] and res["revisits"]["visits"] == d["K"] - 2  # two support points visited once
+    # verify: a second round of the design with that compensation applied
+    again = tmp_path / "v.csv"
+    assert main(["simulate", "--set", "theta1=0.5", "--set", "theta2=-0.3", "--poses", str(out), "--seed", "1",
+                 "--compensation", *map(str, res["zero_offsets_deg"]), "--out", str(again)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(result), str(again), "--json"]) in (0, 1)  # (1: not yet within mu0)
+    assert json.loads(capsys.readouterr().out)["revisits"]["revisited_poses"] == 4
     # compare and a study's spec read the design's poses as rounds
     assert main(["compare", "--poses", str(out), "--set", "theta1=0.5", "--trials", "2", "--methods", "tsvd",
                  "--quiet", "--json"]) == 0
