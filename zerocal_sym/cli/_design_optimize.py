@@ -266,7 +266,7 @@ def _print_text(out, res, robot):
     region = c["region"] + (" mm" if set(pu) == {"mm"} or c["region_kind"] != "box" else "")
     print(f"constraints: region {region}; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "
-          f"{'none' if jl is None else str(jl) + ' ' + ju}; poses >= {c['min_separation_mm']:g} mm apart"
+          f"{'none' if jl is None else str(jl) + ' ' + ju}; distinct poses >= {c['min_separation_mm']:g} mm apart"
           + ("" if set(pu) == {"mm"} else " (a degree counts as a mm)"))
     n = out["noise"]
     print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, {'servo' if ju == 'deg' else 'joint'} "
