@@ -32,6 +32,12 @@ th { background: #f2f2f2; text-align: left; } td.num { text-align: right; font-v
 """
 
 
+#: what a result's 1 sigma includes (its ``std_kind``), in words
+STD_KINDS = {"total": "total (the noise through the model; for TSVD also its linearisation and truncation bias)",
+             "from residuals": "from the residuals (no noise model: the noise level estimated from them)",
+             "lower bound": "a lower bound (a known contribution could not be evaluated)"}
+
+
 def esc(text) -> str:
     return html.escape(str(text), quote=True)
 
@@ -78,7 +84,8 @@ def _offsets(c) -> str:
         return missing("not reported: the result is rejected (see the verdict and the fit check)")
     rows = [[f"<td>{esc(o['name'])}</td>", num(o["value"], "+.6f"), num(o["std"], ".4g")] for o in c["offsets"]]
     body = table(["joint", f"zero offset [{u}]", f"1 sigma [{u}]"], rows)
-    body += (f"<p>1 sigma: {esc(c['result']['std_kind'] or 'as the result file states')}.  Compensation: the "
+    kind = c["result"]["std_kind"]
+    body += (f"<p>1 sigma: {esc(STD_KINDS.get(kind, kind or 'as the result file states'))}.  Compensation: the "
              f"controller subtracts the offset, <code>cmd = IK(P) - offset_{esc(u)}</code> (the actual joint = "
              "commanded + offset).</p>")
     if c["maemm"]:
