@@ -224,7 +224,7 @@ def test_the_goal_judges_the_sigma(capsys, tmp_path, rounds):
     text, accepted = verdict(r, load_result(res, robot=r), goal=0.01)
     assert accepted and "NOT within the goal 0.01 deg" in text
     rc, _, err = zc(capsys, "report", res, "--robot", robot, "--goal", "0", "--out", tmp_path / "x.html")
-    assert rc == 2 and "--goal must be a positive number in deg" in err and not (tmp_path / "x.html").exists()
+    assert rc == 2 and "--goal must be a finite positive number" in err and not (tmp_path / "x.html").exists()
 
 
 # --------------------------------------------------------------------------- the maps' numbers

@@ -443,9 +443,10 @@ def accepted_why(fit: dict, alpha: float) -> str:
     ``fit``; ``alpha``: the level when the record has none)."""
     p = fit.get("p_value")
     if fit.get("accepted_despite_misfit"):
-        return f"accepted despite misfit (--accept-misfit; fit p-value {p:.3g} < {fit.get('alpha', alpha):g})"
+        shown = "?" if p is None else f"{p:.3g}"
+        return f"accepted despite misfit (--accept-misfit; fit p-value {shown} < {fit.get('alpha') or alpha:g})"
     if fit.get("checked") and p is not None:
-        return f"accepted: fit p-value {p:.3g} >= {fit.get('alpha', alpha):g}"
+        return f"accepted: fit p-value {p:.3g} >= {fit.get('alpha') or alpha:g}"
     return f"accepted: fit not checked ({fit.get('reason') or 'no spare degree of freedom'})"
 
 

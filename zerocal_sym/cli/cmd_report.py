@@ -47,7 +47,9 @@ def verdict(robot, rf, goal=None, max_offset=None) -> tuple:
     from zerocal_sym.cli.cmd_identify import accepted_why, offsets_sigma_text
     from zerocal_sym.identify.fitcheck import DEFAULT_ALPHA, plausibility
 
-    fit = rf.raw.get("fit") if isinstance(rf.raw.get("fit"), dict) else {}
+    from zerocal_sym.report.contents import fit_record
+
+    fit = fit_record(rf) or {}
     if not rf.success:
         return f"rejected: {rf.status.removeprefix('rejected: ') or 'the identification failed'}", False
     reasons = plausibility(robot, rf, max_offset=max_offset)
@@ -87,8 +89,6 @@ def run(args):
         check_same_robot(rf, args.result, args.data)
     check_result_robot(rf, robot, args.result)
     meas = load_measurements(args.data, robot) if args.data is not None else None
-    if args.goal is not None and not args.goal > 0:
-        raise ZerocalError(f"--goal must be a positive number in {rf.offset_unit}, got {args.goal:g}")
     text, accepted = verdict(robot, rf, args.goal, max_offset_arg(args, robot))
     c = report_contents(robot, rf, meas, verdict=f"{text}", accepted=accepted)
     pose_rows = None if c["poses"] is None else figures.pose_table(robot, c["poses"])

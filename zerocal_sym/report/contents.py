@@ -126,6 +126,57 @@ def tolerance_bias(rf):
             "tolerances": (rf.raw["bias"].get("tolerances") or {})}
 
 
+def _read(obj, key, kind, where, what):
+    """``obj[key]`` of ``kind`` (``number``, ``bool``, ``str``) or None when missing or null; another type is an
+    error naming ``what``."""
+    v = obj.get(key)
+    if v is None:
+        return None
+    ok = {"number": _number(v), "bool": isinstance(v, bool), "str": isinstance(v, str)}[kind]
+    if not ok:
+        raise DataFileError(f"{what}: '{key}' must be {'a finite number' if kind == 'number' else 'a ' + kind}, got "
+                            f"{json.dumps(v)[:40]}", where=where)
+    return float(v) if kind == "number" else v
+
+
+def fit_record(rf):
+    """The file's ``fit`` (the fit check's record) with the types the report reads checked, or None.
+
+    Returns
+    -------
+    dict or None
+        ``chi2``, ``dof``, ``p_value``, ``alpha`` (float or None); ``checked``, ``rejected``,
+        ``accepted_despite_misfit`` (bool); ``reason``, ``diagnosis`` (str or None); ``warnings`` (list of str);
+        ``readings`` [{``pose``, ``standardised``}]; ``worst`` ({``pose``, ``from_pose``, ``standardised``,
+        ``estimated_error_mm``} or None).
+    """
+    fit, src = rf.raw.get("fit"), rf.source
+    if fit is None:
+        return None
+    if not isinstance(fit, dict):
+        raise DataFileError("key 'fit' must be an object (the fit check's record)", where=src)
+    what = "key 'fit'"
+    out = {k: _read(fit, k, "number", src, what) for k in ("chi2", "dof", "p_value", "alpha")}
+    out.update({k: _read(fit, k, "bool", src, what) is True for k in ("checked", "rejected",
+                                                                       "accepted_despite_misfit")})
+    out.update({k: _read(fit, k, "str", src, what) for k in ("reason", "diagnosis")})
+    warnings = fit.get("warnings") or []
+    if not isinstance(warnings, list) or not all(isinstance(w, str) for w in warnings):
+        raise DataFileError(f"{what}: 'warnings' must be a list of strings", where=src)
+    out["warnings"] = warnings
+    readings = fit.get("readings") or []
+    if not isinstance(readings, list) or not all(isinstance(r, dict) for r in readings):
+        raise DataFileError(f"{what}: 'readings' must be a list of objects, one per reading", where=src)
+    out["readings"] = [{k: _read(r, k, "number", src, f"{what} readings") for k in ("pose", "standardised")}
+                       for r in readings]
+    w = fit.get("worst")
+    if w is not None and not isinstance(w, dict):
+        raise DataFileError(f"{what}: 'worst' must be an object (the worst reading)", where=src)
+    out["worst"] = None if w is None else {k: _read(w, k, "number", src, f"{what} worst") for k in
+                                           ("pose", "from_pose", "standardised", "estimated_error_mm")}
+    return out
+
+
 def data_poses(robot, meas) -> np.ndarray:
     """The measured poses (internal units), shape (K, n): the file's targets, else where the commands lead."""
     if meas.target is not None:
@@ -182,17 +233,21 @@ def report_contents(robot, rf, meas=None, verdict: str = "", accepted: bool = Tr
     maemm = [{"name": n, "value": float(v), "std": float(rf.std.get(n, math.nan))}
              for n, v in zip(errors.measuring, rf.maemm_mm)]
     data = rf.raw.get("data") if isinstance(rf.raw.get("data"), dict) else {}
+    data = {"file": _read(data, "file", "str", rf.source, "key 'data'"), "K": _read(data, "K", "number", rf.source,
+                                                                                     "key 'data'")}
+    std_kind = _read(rf.raw, "std_kind", "str", rf.source, "the results file")
     out = {
         "robot": {"name": robot.name, "mechanism": robot.mechanism_name, "source": robot.source,
                   "sha256": robot.sha256, "description": robot.mechanism.description},
         "result": {"source": rf.source, "method": rf.method, "status": rf.status, "success": rf.success,
-                   "std_kind": rf.raw.get("std_kind"), "data_file": data.get("file"), "K": data.get("K")},
+                   "std_kind": std_kind, "data_file": data["file"],
+                   "K": None if data["K"] is None else int(data["K"])},
         "verdict": verdict, "accepted": bool(accepted), "unit": rf.offset_unit,
         "offsets": [{"name": n, "value": float(v), "std": float(s)}
                     for n, v, s in zip(errors.zero_offsets, rf.zero_offsets_user, rf.std_zero_offsets_user)],
         "maemm": maemm, "covariance": cov, "covariance_source": cov_source,
         "error_budget": error_budget(robot, rf), "bias": tolerance_bias(rf),
-        "fit": rf.raw.get("fit") if isinstance(rf.raw.get("fit"), dict) else None,
+        "fit": fit_record(rf),
         "residuals": residuals(rf, meas, robot),
         "poses": None if meas is None else data_poses(robot, meas),
         "data_source": None if meas is None else meas.source,

@@ -131,9 +131,10 @@ def _fit(c, fig_png) -> str:
             f"of freedom, p-value {num(fit.get('p_value'), '.3g', tag='span')} against the significance level "
             f"{num(fit.get('alpha'), 'g', tag='span')}: <strong>{esc(decision)}</strong>.</p>")
     w = fit.get("worst")
-    if isinstance(w, dict) and w.get("pose") is not None:
-        body += (f'<p id="worst-reading">The worst reading: <strong>pose {esc(w.get("pose"))}</strong> (the change '
-                 f"from pose {esc(w.get('from_pose'))}), standardised residual "
+    if w is not None and w.get("pose") is not None:
+        frm = "?" if w.get("from_pose") is None else f"{w['from_pose']:g}"
+        body += (f'<p id="worst-reading">The worst reading: <strong>pose {w["pose"]:g}</strong> (the change '
+                 f"from pose {esc(frm)}), standardised residual "
                  f"{num(w.get('standardised'), '+.3f', tag='span')}, its estimated error "
                  f"{num(w.get('estimated_error_mm'), '+.4g', 'mm', tag='span')}.</p>")
     if fit.get("diagnosis"):
