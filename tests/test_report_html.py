@@ -296,3 +296,16 @@ def test_a_mechanism_without_a_sketch_is_drawn_without_it(monkeypatch):
     robot = load_robot(EX / "delta.toml")
     monkeypatch.setattr(kin, "sketch", lambda robot, P, theta=None: None)
     assert figures.png(figures.figure_robot(robot))[:4] == b"\x89PNG"
+
+
+def test_data_of_another_round_of_the_same_robot_are_refused(capsys, tmp_path, rounds):
+    """The same robot and K, another seed: its residuals at the result's estimate are not the result's."""
+    robot, data, res = rounds["delta_rotary"]
+    other = tmp_path / "other.csv"
+    assert main(["simulate", "--robot", str(robot), "--set", "theta1=2", "--set", "theta2=-1", "--set",
+                 "theta3=0.5", "--noise", "scale-only", "--seed", "5", "--out", str(other)]) == 0
+    capsys.readouterr()
+    out = tmp_path / "r.html"
+    rc, _, err = zc(capsys, "report", res, "--robot", robot, "--data", other, "--out", out)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and not out.exists(), err
+    assert f"{other}: not the data the result {res} was identified from" in err

@@ -7,8 +7,9 @@ the error budget when the result file holds one, the fit check with the
 worst reading named, the residuals, the robot with its poses in the
 workspace, and the position error predicted over the workspace before and
 after the compensation with its uncertainty (from the offsets' covariance).
-``--data`` (the measurement file the result was identified from) adds the
-poses and the nominal model's residuals.
+``--data`` (the measurement file the result was identified from: checked,
+its residuals at the result's estimate must be the result's) adds the poses
+and the nominal model's residuals.
 
 The result, the data and the robot file must be of one robot: a result and
 a data file whose ``robot_sha256`` differ are refused, and so is a result of

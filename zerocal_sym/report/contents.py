@@ -29,6 +29,9 @@ from zerocal_sym.model import units
 LIMITED_BY = ("data", "robot file")
 #: a covariance's diagonal and the file's 1 sigma of the offsets: two copies of one number (relative)
 SAME_STD_RTOL = 1e-6
+#: the residuals of the data a result was identified from, recomputed at its estimate, agree with the file's to
+#: round-off: a nanometre is far below any scale's resolution (mm)
+SAME_DATA_TOL_MM = 1e-6
 
 
 def _number(x) -> bool:
@@ -187,6 +190,9 @@ def data_poses(robot, meas) -> np.ndarray:
 def residuals(rf, meas=None, robot=None):
     """The residuals per reading: the file's at the estimate, and with the data the nominal model's.
 
+    With the data, the file's residuals are recomputed from them at the file's estimate (the exact model): data
+    they do not reproduce are not the data the result was identified from (a DataFileError naming both).
+
     Returns
     -------
     dict or None
@@ -203,7 +209,17 @@ def residuals(rf, meas=None, robot=None):
             raise DataFileError(f"the data have {meas.K} poses ({meas.K - 1} readings), the result {after.size} "
                                 f"residuals ({rf.source}): not the data this result was identified from",
                                 where=meas.source)
-        before = np.asarray(meas.readings, float)[1:] - np.diff(kin.distance(robot, meas.theta_cmd))
+        readings = np.asarray(meas.readings, float)[1:]
+        before = readings - np.diff(kin.distance(robot, meas.theta_cmd))
+        if rf.estimate:  # the same data at the same estimate: the same residuals, to round-off
+            errors = robot.errors
+            err = errors.vector({n: errors.from_user_value(n, v) for n, v in rf.estimate.items()})
+            with np.errstate(all="ignore"):
+                again = readings - np.diff(kin.distance(robot, meas.theta_cmd, err))
+            worst = float(np.max(np.abs(again - after))) if np.all(np.isfinite(again)) else math.inf
+            if not worst <= SAME_DATA_TOL_MM:
+                raise DataFileError(f"not the data the result {rf.source} was identified from: its residuals at the "
+                                    f"estimate differ from these data's by up to {worst:.3g} mm", where=meas.source)
     return {"pose": np.arange(1, after.size + 1), "after_mm": after, "before_mm": before, "method": rf.method,
             "rms_after_mm": float(np.sqrt(np.mean(after**2))),
             "rms_before_mm": None if before is None else float(np.sqrt(np.mean(before**2)))}
