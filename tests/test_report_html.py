@@ -230,11 +230,12 @@ def test_the_goal_judges_the_sigma(capsys, tmp_path, rounds):
 # --------------------------------------------------------------------------- the maps' numbers
 
 
-@pytest.mark.parametrize("robot_file", ["delta.toml", "hexapod.toml"])
+@pytest.mark.parametrize("robot_file", ["paper_robot.toml", "delta.toml", "hexapod.toml"])
 def test_the_propagated_uncertainty_is_the_monte_carlo_spread(robot_file):
-    """At a few poses, offsets drawn from N(estimate, C): the RMS position error left by compensating with the
-    estimate, and the spread of the uncompensated error's length, are the maps' (within 4 standard errors of the
-    Monte Carlo plus the first order's neglect, bounded by the offsets' size over their lever)."""
+    """At a few poses, offsets drawn from N(estimate, C) (a spread of about 1/20 of the offsets, as a calibration
+    gives): the RMS position error left by compensating with the estimate, and the spread of the uncompensated
+    error's length, are the maps' -- within 4 standard errors of the Monte Carlo plus the first order's neglect,
+    the relative (spread / error)^2 (the length of an error is not linear in it)."""
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.robot import load_robot
     from zerocal_sym.report.accuracy import position_axes, predicted_errors
@@ -242,11 +243,10 @@ def test_the_propagated_uncertainty_is_the_monte_carlo_spread(robot_file):
     robot = load_robot(EX / robot_file)
     rng = np.random.default_rng(7)
     m, pos = robot.m, position_axes(robot)[0]
-    unit = robot.errors.offset_unit
-    scale = 0.02 if unit == "rad" else 0.3  # offsets of about a degree, or 0.3 mm
+    scale = 0.02 if robot.errors.offset_unit == "rad" else 0.3  # offsets of about a degree, or 0.3 mm
     offsets = rng.normal(0, scale, m)
-    A = rng.normal(0, scale / 10, (m, m))
-    cov = A @ A.T + np.eye(m) * (scale / 20) ** 2
+    A = rng.normal(0, scale / 100, (m, m))
+    cov = A @ A.T + np.eye(m) * (scale / 200) ** 2
     lo, hi = robot.workspace.bounds()
     P = robot.workspace.centre() + (rng.uniform(-0.4, 0.4, (3, robot.n)) * (hi - lo))
     pred = predicted_errors(robot, offsets, cov, P)
@@ -254,14 +254,15 @@ def test_the_propagated_uncertainty_is_the_monte_carlo_spread(robot_file):
     draws = rng.multivariate_normal(offsets, cov, N)
     theta = kin.ik(robot, P)
     for k in range(len(P)):
+        second = (pred["after_mm"][k] / pred["before_mm"][k]) ** 2
         after = kin.fk(robot, theta[k] + draws - offsets)[:, pos] - P[k, pos]  # compensated with the estimate
         sq = np.sum(after**2, axis=1)
         rms, se = math.sqrt(sq.mean()), sq.std() / math.sqrt(N) / (2 * math.sqrt(sq.mean()))
-        assert abs(rms - pred["after_mm"][k]) < 4 * se + 0.05 * pred["after_mm"][k], (k, rms, pred["after_mm"][k])
+        assert abs(rms - pred["after_mm"][k]) < 4 * se + second * rms, (k, rms, pred["after_mm"][k])
         before = np.linalg.norm(kin.fk(robot, theta[k] + draws)[:, pos] - P[k, pos], axis=1)
         sd = before.std()
         se_sd = sd / math.sqrt(2 * (N - 1))
-        assert abs(sd - pred["before_std_mm"][k]) < 4 * se_sd + 0.05 * sd, (k, sd, pred["before_std_mm"][k])
+        assert abs(sd - pred["before_std_mm"][k]) < 4 * se_sd + second * sd, (k, sd, pred["before_std_mm"][k])
         exact = np.linalg.norm(kin.fk(robot, theta[k] + offsets)[0, pos] - P[k, pos])
         assert math.isclose(pred["before_mm"][k], exact, rel_tol=1e-9)
 

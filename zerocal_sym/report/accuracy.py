@@ -8,8 +8,9 @@ before
     zero offsets are the identified ones: ``|FK_actual(IK(P)) - P|`` over the
     position coordinates (mm), exact forward kinematics; its 1 sigma
     propagated from the offsets' covariance ``C`` (m, m) to first order,
-    ``sqrt(u^T J C J^T u)`` with ``J`` (3, m) = dP/d(offsets) and ``u`` the
-    error's direction;
+    ``sqrt(u^T J C J^T u)`` with ``J`` (3, m) = dP/d(offsets) where the robot
+    then stands (the joints ``IK(P) + offsets``) and ``u`` the error's
+    direction;
 after
     what the offsets' uncertainty leaves once they are compensated: the
     error ``J (offsets_true - offsets_estimated)`` is ``N(0, J C J^T)``, whose
@@ -116,10 +117,14 @@ def predicted_errors(robot, offsets, cov, P) -> dict:
            "after_deg": np.full(len(P), np.nan) if rot else None}
     if cov is None:
         return out
+    # before: the uncompensated robot stands at FK(theta + offsets), where the offsets' uncertainty moves it
+    Jb = offset_jacobian(robot, P + dP, theta + np.asarray(offsets, float))[:, pos]
+    Cb = np.einsum("kim,mn,kjn->kij", Jb, cov, Jb)
+    u = dP[:, pos] / np.where(before > 0, before, 1.0)[:, None]
+    out["before_std_mm"] = np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", u, Cb, u), 0.0))
+    # after: compensated, it stands at the pose up to the estimate's error
     J = offset_jacobian(robot, P, theta)
     Cp = np.einsum("kim,mn,kjn->kij", J[:, pos], cov, J[:, pos])  # (K, 3, 3): the position error's covariance
-    u = dP[:, pos] / np.where(before > 0, before, 1.0)[:, None]
-    out["before_std_mm"] = np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", u, Cp, u), 0.0))
     out["after_mm"] = np.sqrt(np.maximum(np.trace(Cp, axis1=1, axis2=2), 0.0))
     if rot:
         Cr = np.einsum("kim,mn,kjn->kij", J[:, rot], cov, J[:, rot])
