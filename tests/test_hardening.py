@@ -416,7 +416,7 @@ def fuzz_cases():
               None: ["", "nan", "-1"]}
     base = {"simulate": ["--group", "1", "--out", "OUT"], "identify": ["DATA", "--method", "tsvd"],
             "compensate": ["RESULT", "--out", "OUT"], "verify": ["RESULT", "DATA2", "--out", "OUT"],
-            "design": [], "robot": []}
+            "design": [], "robot": [], "report": ["RESULT", "--out", "OUT"]}
     skip = {"--set", "--group", "--method", "--out", "--robot", "--plot", "--poses", "--params", "--prior-std",
             "--bound", "--max-iter", "--truncation", "--rule"}
     from zerocal_sym.cli import build_parser

@@ -6,7 +6,8 @@ of the design beside the paper's scheme with the same K, the CRLB of the zero
 offsets and their ratio; ``--verify N`` adds a Monte Carlo with the Ipopt
 estimator (:func:`zerocal_sym.design.verify_design`) for both designs;
 ``--plot PNG`` draws them in the workspace.  Nothing is written (plot) unless
-everything succeeded.
+everything succeeded.  On a terminal a progress bar (tqdm) counts its steps
+on stderr; in a log or a pipe it is quiet.
 
 Any mechanism: the design region is the robot's workspace shape (a rectangle
 ``XMIN XMAX YMIN YMAX``, a cylinder ``RW ZMIN ZMAX``, a box ``X_MIN X_MAX ...
@@ -169,6 +170,32 @@ def _fmt(v, spec=".4g"):
     return format(v, spec)
 
 
+class _Bar:
+    """``progress(done, total)`` of :func:`zerocal_sym.design.optimize_design` as a tqdm bar on stderr."""
+
+    def __init__(self, stream):
+        self.stream, self.bar = stream, None
+
+    def __call__(self, done, total):
+        from zerocal_sym.identify.progress import Progress
+
+        if self.bar is None:
+            self.bar = Progress(total, "design", stream=self.stream, unit="step")
+        self.bar(done)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def progress_bar(stream=None):
+    """A progress bar on a terminal (tqdm, as compare's); none when stderr is not one (a log, a pipe: quiet)."""
+    import sys
+
+    stream = sys.stderr if stream is None else stream
+    return _Bar(stream) if getattr(stream, "isatty", lambda: False)() else None
+
+
 def run(args, robot):
     import numpy as np
 
@@ -207,12 +234,16 @@ def run(args, robot):
     cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"), robot)
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
+    bar = progress_bar()
     try:
         res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
-                                     exchange_starts=starts, tolerances=tol, method=method)
+                                     exchange_starts=starts, tolerances=tol, method=method, progress=bar)
     except BaseException:
         _parallel.close(ex)
         raise
+    finally:
+        if bar is not None:
+            bar.close()
     out = res.to_dict()
     out["robot"] = robot.name
     out["mechanism"] = robot.mechanism_name

@@ -439,14 +439,7 @@ def evaluation_point(robot, meas, res, prior):
 
 def verdict_line(res, args) -> str:
     """The one line a person acts on: accepted / why, the offsets' 1 sigma, the next command."""
-    fit = res.info.get("fit") or {}
-    p = fit.get("p_value")
-    if fit.get("accepted_despite_misfit"):
-        why = f"accepted despite misfit (--accept-misfit; fit p-value {p:.3g} < {fit.get('alpha', args.fit_alpha):g})"
-    elif fit.get("checked") and p is not None:
-        why = f"accepted: fit p-value {p:.3g} >= {fit.get('alpha', args.fit_alpha):g}"
-    else:
-        why = f"accepted: fit not checked ({fit.get('reason') or 'no spare degree of freedom'})"
+    why = accepted_why(res.info.get("fit") or {}, args.fit_alpha)
     robot = ["--robot", args.robot] if getattr(args, "robot", None) else []
     compensate = _command("compensate", args.out or "RESULT.json", *robot, "--out", "table.csv")
     nxt = (compensate if args.out else
@@ -454,6 +447,18 @@ def verdict_line(res, args) -> str:
     goal = getattr(args, "goal", None)
     goal = goal if goal is not None else getattr(args, "goal_deg", None)
     return f"verdict: {why}; {offsets_sigma_text(res, goal)}; next: {nxt}"
+
+
+def accepted_why(fit: dict, alpha: float) -> str:
+    """How an accepted result passed the fit check (``fit``: its record, ``info["fit"]`` or a results file's
+    ``fit``; ``alpha``: the level when the record has none)."""
+    p = fit.get("p_value")
+    if fit.get("accepted_despite_misfit"):
+        shown = "?" if p is None else f"{p:.3g}"
+        return f"accepted despite misfit (--accept-misfit; fit p-value {shown} < {fit.get('alpha') or alpha:g})"
+    if fit.get("checked") and p is not None:
+        return f"accepted: fit p-value {p:.3g} >= {fit.get('alpha') or alpha:g}"
+    return f"accepted: fit not checked ({fit.get('reason') or 'no spare degree of freedom'})"
 
 
 def _command(*words) -> str:

@@ -353,7 +353,7 @@ def _scales(robot, P, noise):
 
 
 def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                      n_starts: int = 8, starts=None, max_iter: int = 500, tolerances=None):
+                      n_starts: int = 8, starts=None, max_iter: int = 500, tolerances=None, step=None):
     """Multi-start Ipopt over the K poses.
 
     Parameters
@@ -372,6 +372,8 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         Extra starts (e.g. the boundary scheme, an exchange design).
     tolerances : dict, optional
         Tolerances of the omitted errors (``mse``).
+    step : callable, optional
+        ``step()`` after each Ipopt start (progress).
 
     Returns
     -------
@@ -407,6 +409,8 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         runs.append({"start": label, "value": _user_value(criterion, o, robot.errors.offset_unit), "status": status,
                      "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
+        if step is not None:
+            step()
         if not viol and np.isfinite(o) and (best is None or o < best[1]):
             best = (P, o)
     if best is None:

@@ -271,3 +271,10 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES, allow_revisi
     if robot is not None:
         check_against_robot(meas, robot)
     return meas
+
+
+def read_metadata(path) -> dict:
+    """The ``# key: value`` lines of a measurement file, without reading its rows (e.g. its ``robot_sha256``
+    before the file is checked against a robot)."""
+    text, src = _read_text(path)
+    return _split_csv(text, src, "# zerocal measurements", FORMAT_VERSION)[0]
