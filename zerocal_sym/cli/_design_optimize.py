@@ -42,8 +42,10 @@ def add_arguments(p):
                    help="exact (exchange + Ipopt), approx (the optimal design measure, rounded, with a "
                         "certificate) or auto: exact up to K = 24 (default)")
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
-                   help="tolerance of an error the identification leaves out (mm; deg for angles), repeatable; "
-                        "default: set A of Table 2 (planar), 0.02 mm per length and 0.002 deg per angle (others)")
+                   help="tolerance of an error the identification leaves out, or of a group of them (L for L1 L2 "
+                        "L3) (mm; deg for angles), repeatable; default the robot file's [tolerances], else 0.5 mm "
+                        "per length and 0.05 deg per angle (a robot measured by hand; the paper's robot: Table 2's "
+                        "set A)")
     from zerocal_sym.cli._paths import InputFile
 
     p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
@@ -153,10 +155,12 @@ def constraints_from_args(robot, args):
 
 def tolerances_from_args(robot, args):
     """Tolerances of the omitted errors (internal units) from ``--tolerance``, ``--tolerance-file``, ``--tolerance-scale``."""
+    from zerocal_sym.design.terms import design_params
     from zerocal_sym.identify.bias import make_tolerances
 
     return make_tolerances(robot, getattr(args, "tolerance", None) or [], getattr(args, "tolerance_file", None),
-                           getattr(args, "tolerance_scale", 1.0), bias_model=getattr(args, "bias_model", "rms"))
+                           getattr(args, "tolerance_scale", 1.0), params=design_params(robot),
+                           bias_model=getattr(args, "bias_model", "rms"))
 
 
 def _fmt(v, spec=".4g"):
