@@ -210,6 +210,17 @@ def run(args, robot):
                                  "--method approx takes any K)")
     cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"), robot)
+    choice = None
+    if getattr(args, "choose_params", False):  # the set too: the least expected offset error at K
+        import sys
+
+        from zerocal_sym.design.choose import choose_design_params
+
+        if not args.json:
+            print(f"choosing the parameter set (approximate designs, K = {K}):", file=sys.stderr)
+        choice = choose_design_params(robot, K, args.criterion, cons, noise, tol, seed=args.seed, starts=starts,
+                                      progress=None if args.json else lambda line: print(line, file=sys.stderr))
+        robot = robot.identifying(choice["chosen"])
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
     try:
         res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
@@ -218,6 +229,14 @@ def run(args, robot):
         _parallel.close(ex)
         raise
     out = res.to_dict()
+    from zerocal_sym.design.terms import design_params
+
+    out["params"] = list(design_params(robot))
+    out["params_spec"] = robot.identified_set
+    if choice is not None:
+        from zerocal_sym.io.files import json_safe
+
+        out["params_choice"] = json_safe(choice)
     out["robot"] = robot.name
     out["mechanism"] = robot.mechanism_name
     out["seed"] = args.seed
@@ -267,6 +286,14 @@ def _print_text(out, res, robot):
     pu = out.get("pose_units") or pose_units(robot)
     print(f"Optimised measurement poses: robot {out['robot']}, K = {out['K']}, criterion {crit} "
           f"({_desc(crit)})")
+    if out.get("params_choice"):
+        ch = out["params_choice"]
+        print(f"parameters chosen: {ch['chosen']} (expected offset error {_fmt(ch['expected'])} {ch['unit']} at "
+              f"its design; {ch['base']} alone {_fmt(ch['base_expected'])} {ch['unit']}; {len(ch['table'])} sets, "
+              f"{ch['search']})")
+    if out.get("params") and out["params"] != list(robot.errors.resolve("paper")):
+        print(f"designed for identifying: {', '.join(out['params'])} (then: zerocal identify ... --params "
+              f"{out['params_spec']})")
     region = c["region"] + (" mm" if set(pu) == {"mm"} or c["region_kind"] != "box" else "")
     print(f"constraints: region {region}; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "

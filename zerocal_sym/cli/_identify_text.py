@@ -92,6 +92,7 @@ def limit_text(remedy: dict, args, K=None) -> str:
         return remedy["text"]
     robot = ["--robot", args.robot] if getattr(args, "robot", None) else []
     spec = remedy["params"]
+    K = max(K, remedy["n_params"] + 2) if K else None  # (at least one spare degree of freedom)
     design = _command("design", *robot, "--params", spec, "--optimize", *(["--K", K] if K else []))
     return (f"{remedy['text']}; to lower it: measure {compact_names(remedy['free'])} better and give their "
             f"tolerances in the robot file's [tolerances], or identify them too: {design} (or --choose-params), "
@@ -158,11 +159,13 @@ def print_choice(choice: dict) -> None:
 
 def print_group_test(test: dict) -> None:
     """The likelihood-ratio test of each group of robot-file entries, as text."""
+    from zerocal_sym.identify.fitstats import _fmt_p
+
     print(f"robot-file test (each group of entries held at the file's values freed in turn; alpha {test['alpha']:g}):")
     for r in test["groups"]:
         if not r["tested"]:
             print(f"  {r['group']:5s} not tested: {r['reason']}")
             continue
         print(f"  {r['group']:5s} chi2 {test['chi2']:.4g} -> {r['chi2']:.4g}, LR {r['lr']:.4g} on {r['dof']} dof, "
-              f"p = {r['p_value']:.3g}" + ("  CONTRADICTED" if r["contradicted"] else ""))
+              f"{_fmt_p(r['p_value'])}" + ("  CONTRADICTED" if r["contradicted"] else ""))
     print(f"  -> {test['summary']}")

@@ -321,7 +321,7 @@ def run(args):
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
     bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=err0)
     out["bias"] = bias
-    out.update(budget_entries(robot, res, bias, names, choice, args, meas, noise, prior))
+    out.update(budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol))
     if not res.success:
         if args.json:
             print(to_json(out))
@@ -387,7 +387,7 @@ def run(args):
     return 0
 
 
-def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior) -> dict:
+def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol) -> dict:
     """The results JSON's ``error_budget``, ``limited_by``, ``remedy``, and ``params_choice`` (``--params auto``)
     and ``robot_file_test`` (``--test-groups``, or an nlls fit rejected without a detected cause)."""
     from zerocal_sym.identify import budget as bg
@@ -406,9 +406,12 @@ def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior) ->
         from zerocal_sym.identify.freeing import free_each_group
 
         out["robot_file_test"] = free_each_group(robot, meas, spec, noise=noise, prior=prior, alpha=args.fit_alpha,
+                                                 tolerances=tol,
                                                  held=res if res.method == "nlls" and not args.bound
                                                  and not args.prior_std and args.loss in (None, "l2") else None)
-    return out
+    from zerocal_sym.io.files import json_safe
+
+    return json_safe(out)
 
 
 def evaluation_point(robot, meas, res, prior):

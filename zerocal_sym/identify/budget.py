@@ -145,7 +145,7 @@ def compact_names(names) -> str:
 
 def remedy(budget: list, robot, params) -> dict:
     """What to do about an answer: ``limited_by``, ``free`` (entries to identify too, or []), ``params`` (the
-    set that frees them, joined by ``+``), ``text`` (why, one clause)."""
+    set that frees them, joined by ``+``) and ``n_params`` (its size), ``text`` (why, one clause)."""
     lim = limited_by(budget)
     if lim == "data":
         return {"limited_by": lim, "free": [], "params": None,
@@ -161,7 +161,7 @@ def remedy(budget: list, robot, params) -> dict:
     spec = "+".join([params if isinstance(params, str) else ",".join(names), ",".join(free)])
     worst = max(budget, key=lambda b: b["robot_file_bias"] - (b.get("noise_std") or 0.0))
     s = worst.get("noise_std")
-    return {"limited_by": lim, "free": free, "params": spec,
+    return {"limited_by": lim, "free": free, "params": spec, "n_params": len(robot.errors.resolve(spec)),
             "text": (f"limited by the robot file ({held}): {worst['name']} may be off by up to "
                      f"{worst['robot_file_bias']:.3g} {worst['unit']} from it against a 1 sigma of "
                      + (f"{s:.3g}" if s is not None else "?") + f" {worst['unit']} from the data")}

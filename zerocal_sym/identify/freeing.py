@@ -34,7 +34,7 @@ Z_NAMED = 3.0
 
 
 def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: float = DEFAULT_ALPHA,
-                    held=None) -> dict:
+                    held=None, tolerances=None) -> dict:
     """The likelihood-ratio test of each group of held robot-file entries (module docstring).
 
     Parameters
@@ -45,6 +45,9 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
         A group is contradicted when its p-value is below ``alpha``.
     held : IdentificationResult, optional
         The held fit, if already made (its chi² and rank are used).
+    tolerances : dict, optional
+        name -> tolerance (internal units) of the held entries (default the robot's): how far the freed fit
+        puts each entry from the file, in tolerances, ranks the groups that explain the data.
 
     Returns
     -------
@@ -52,12 +55,16 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
         ``params`` (the held set), ``chi2``, ``rank`` of the held fit, ``alpha``, ``groups``: per group
         ``group``, ``entries``, ``tested`` (False: too few readings, or the freed fit did not converge:
         ``reason``), ``chi2``, ``lr``, ``dof``, ``p_value``, ``contradicted``, ``estimates`` (entry ->
-        {``value``, ``std``, ``unit``, ``z``}), ``named`` (entries beyond :data:`Z_NAMED` sigma);
-        ``contradicted`` (the groups' names, smallest p first), ``summary`` (a sentence).
+        {``value``, ``std``, ``unit``, ``z``}), ``named`` (entries beyond :data:`Z_NAMED` sigma), ``fits``
+        (the freed fit passes the fit check at ``alpha``), ``in_tolerances`` (the largest ``|estimate| /
+        tolerance`` of its entries); ``contradicted`` (the groups whose p-value is below ``alpha``: first those
+        whose freed fit passes, the nearest to their tolerances first), ``explained_by`` (the first of them if
+        its freed fit passes, else None), ``summary`` (a sentence).
     """
     from zerocal_sym.identify.nlls import identify_nlls
 
     errors = robot.errors
+    tol = robot.tolerances() if tolerances is None else dict(tolerances)
     names = errors.resolve(params)
     base = params if isinstance(params, str) else ",".join(names)
     K = np.asarray(meas.theta_cmd).shape[0]
@@ -96,24 +103,38 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
             est[n] = {"value": errors.to_user_value(n, v), "std": errors.to_user_value(n, s) if math.isfinite(s) else None,
                       "unit": errors[n].user_unit, "z": z if math.isfinite(z) else None}
         named = [n for n in entries if est[n]["z"] is not None and est[n]["z"] > Z_NAMED]
+        dof1 = (K - 1) - rank1  # (a rank-deficient fit uses fewer)
+        ratio = max((abs(free.value(n)) / tol[n] if tol.get(n, 0) > 0 else math.inf) for n in entries)
         row.update(tested=True, chi2=chi1, lr=lr, dof=d, p_value=p, contradicted=bool(p < alpha), estimates=est,
-                   named=named)
-    hit = sorted((r for r in rows if r["contradicted"]), key=lambda r: r["p_value"])
+                   named=named, fits=bool(dof1 > 0 and chi2_sf(chi1, dof1) >= alpha),
+                   in_tolerances=ratio if math.isfinite(ratio) else None)
+    hit = sorted((r for r in rows if r["contradicted"]),
+                 key=lambda r: (not r["fits"], r["in_tolerances"] if r["in_tolerances"] is not None else math.inf,
+                                r["p_value"]))
     return {"params": base, "chi2": chi0, "rank": rank0, "alpha": float(alpha), "groups": rows,
-            "contradicted": [r["group"] for r in hit], "summary": summary(hit, rows, alpha)}
+            "contradicted": [r["group"] for r in hit],
+            "explained_by": hit[0]["group"] if hit and hit[0]["fits"] else None,
+            "summary": summary(hit, rows, alpha)}
 
 
 def summary(hit: list, rows: list, alpha: float) -> str:
-    """One sentence: the groups the data contradict (with the entries named), or that none is."""
+    """One sentence: the group that explains what the data contradict (its entries), the others that would."""
     if not hit:
         tested = [r["group"] for r in rows if r["tested"]]
         return (f"no group of robot-file entries is contradicted by the data (tested: {', '.join(tested) or 'none'}, "
                 f"each at {alpha:g})")
-    parts = []
-    for r in hit:
-        named = r["named"] or r["entries"]
-        vals = ", ".join(f"{n} {r['estimates'][n]['value']:+.3g} +- {r['estimates'][n]['std']:.2g} "
-                         f"{r['estimates'][n]['unit']}" for n in named if r["estimates"][n]["std"] is not None)
-        parts.append(f"{r['group']} (freeing it lowers chi2 by {r['lr']:.4g} on {r['dof']} dof, "
-                     f"{_fmt_p(r['p_value'])}; off the file by {vals})")
-    return "the data contradict the robot file's " + "; ".join(parts)
+    first = hit[0]
+    named = first["named"] or first["entries"]
+    vals = ", ".join(f"{n} {first['estimates'][n]['value']:+.3g} +- {first['estimates'][n]['std']:.2g} "
+                     f"{first['estimates'][n]['unit']}" for n in named if first["estimates"][n]["std"] is not None)
+    text = (f"the data contradict the robot file's {first['group']}: identified too, chi2 falls from "
+            f"{first['chi2'] + first['lr']:.4g} to {first['chi2']:.4g} (LR on {first['dof']} dof, "
+            f"{_fmt_p(first['p_value'])})" + (f"; {vals}" if vals else "")
+            + (f" ({first['in_tolerances']:.2g} x its tolerance)" if first["in_tolerances"] is not None else ""))
+    if not first["fits"]:
+        text += "; the fit still does not pass: more than this group is off"
+    if hit[1:]:
+        text += "; " + ", ".join(r["group"] + (f" ({r['in_tolerances']:.2g} x its tolerance)"
+                                               if r["in_tolerances"] is not None else "")
+                                 for r in hit[1:]) + " would lower chi2 too"
+    return text
