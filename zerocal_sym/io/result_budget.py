@@ -64,7 +64,7 @@ def _budget_entry(b, j, name, held, mech, std, unit, where, same_tol) -> bool:
         raise DataFileError(f"{what} ({name}): dominant_entries must be a list", where=where)
     total = 0.0
     for e in entries:
-        ok = (isinstance(e, dict) and e.get("name") in held
+        ok = (isinstance(e, dict) and isinstance(e.get("name"), str) and e["name"] in held
               and all(_finite_number(e.get(k)) for k in ("tolerance", "sensitivity", "contribution"))
               and e["tolerance"] >= 0 and e["contribution"] >= 0)
         if not ok:
