@@ -90,13 +90,16 @@ def limit_text(remedy: dict, args, K=None) -> str:
 
     if remedy["limited_by"] == "data":
         return remedy["text"]
+    measure = (f"{remedy['text']}; to lower it: measure {compact_names(remedy['limiting'])} better and give their "
+               "tolerances in the robot file's [tolerances]")
+    if not remedy["free"]:
+        return measure
     robot = ["--robot", args.robot] if getattr(args, "robot", None) else []
     spec = remedy["params"]
     K = max(K, remedy["n_params"] + 2) if K else None  # (at least one spare degree of freedom)
     design = _command("design", *robot, "--params", spec, "--optimize", *(["--K", K] if K else []))
-    return (f"{remedy['text']}; to lower it: measure {compact_names(remedy['free'])} better and give their "
-            f"tolerances in the robot file's [tolerances], or identify them too: {design} (or --choose-params), "
-            f"measure those poses and identify them with --params {spec}")
+    return (f"{measure}, or identify {compact_names(remedy['free'])} too: {design} (or --choose-params), measure "
+            f"those poses and identify them with --params {spec}")
 
 
 def _command(*words) -> str:

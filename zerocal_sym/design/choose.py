@@ -66,7 +66,7 @@ def choose_design_params(robot, K: int, criterion: str, cons, noise, tolerances,
         row["groups"] = list(combo)
         rows.append(row)
         if progress is not None:
-            progress(f"  {spec}: expected offset error {row['expected']:.4g}"
+            progress(f"  {spec}: expected offset error {row['expected']:.4g} {robot.errors.offset_user_unit}"
                      + (f" ({row['reason']})" if row["reason"] else ""))
         return row
 

@@ -144,24 +144,31 @@ def compact_names(names) -> str:
 
 
 def remedy(budget: list, robot, params) -> dict:
-    """What to do about an answer: ``limited_by``, ``free`` (entries to identify too, or []), ``params`` (the
-    set that frees them, joined by ``+``) and ``n_params`` (its size), ``text`` (why, one clause)."""
+    """What to do about an answer: ``limited_by``, ``limiting`` (the robot-file entries that limit it),
+    ``free`` (those of them that can be identified too: not the ones that fix the mechanism's gauge), ``params``
+    (the set that frees them, joined by ``+``; None when none can) and ``n_params`` (its size), ``text`` (why,
+    one clause)."""
     lim = limited_by(budget)
     if lim == "data":
-        return {"limited_by": lim, "free": [], "params": None,
+        return {"limited_by": lim, "limiting": [], "free": [], "params": None, "n_params": None,
                 "text": "limited by the data: more poses or a better design lower it"}
-    order = {n: k for k, n in enumerate(robot.errors.names)}
-    free = sorted(entries_to_free(budget), key=order.get)
+    errors = robot.errors
+    order = {n: k for k, n in enumerate(errors.names)}
+    gauge = set(errors.names) - set(errors.resolve("gauge_fixed")) if "gauge_fixed" in errors.extra_sets else set()
+    limiting = sorted(entries_to_free(budget), key=order.get)
+    free = [n for n in limiting if n not in gauge]  # (the entries that fix the gauge stay held)
     tol = {e["name"]: (e["tolerance"], e["unit"]) for b in budget for e in b["dominant_entries"]}
     by_tol: dict = {}
-    for n in free:
+    for n in limiting:
         by_tol.setdefault(tol[n], []).append(n)
     held = ", ".join(f"{compact_names(ns)} at +-{v:g} {u}" for (v, u), ns in by_tol.items())
-    names = list(robot.errors.resolve(params))
-    spec = "+".join([params if isinstance(params, str) else ",".join(names), ",".join(free)])
+    spec = None
+    if free:
+        spec = "+".join([params if isinstance(params, str) else ",".join(errors.resolve(params)), ",".join(free)])
     worst = max(budget, key=lambda b: b["robot_file_bias"] - (b.get("noise_std") or 0.0))
     s = worst.get("noise_std")
-    return {"limited_by": lim, "free": free, "params": spec, "n_params": len(robot.errors.resolve(spec)),
+    return {"limited_by": lim, "limiting": limiting, "free": free, "params": spec,
+            "n_params": len(errors.resolve(spec)) if spec else None,
             "text": (f"limited by the robot file ({held}): {worst['name']} may be off by up to "
                      f"{worst['robot_file_bias']:.3g} {worst['unit']} from it against a 1 sigma of "
                      + (f"{s:.3g}" if s is not None else "?") + f" {worst['unit']} from the data")}

@@ -36,10 +36,14 @@ EXHAUSTIVE_GROUPS = 8
 
 def held_groups(robot, base="paper") -> dict:
     """Groups (name -> entries) of the source errors ``base`` holds (:func:`zerocal_sym.model.tolerances.groups`),
-    each restricted to its held entries."""
-    keep = set(robot.errors.resolve(base))
+    each restricted to its held entries that can be identified: not those the mechanism holds to fix its gauge
+    (its ``gauge_fixed`` set leaves them out: the Delta's ``phi1``, ``z1``)."""
+    errors = robot.errors
+    keep = set(errors.resolve(base))
+    if "gauge_fixed" in errors.extra_sets:
+        keep |= set(errors.names) - set(errors.resolve("gauge_fixed"))
     out = {}
-    for g, names in tl.groups(robot.errors).items():
+    for g, names in tl.groups(errors).items():
         held = tuple(n for n in names if n not in keep)
         if held:
             out[g] = held
