@@ -11,7 +11,11 @@ priors (MAP) and bounds.  ``--method tsvd``: the paper's truncated SVD of the
 linearised model (Eq. 29): the m zero offsets and the n MAEMM components.
 
 Output: the zero offsets with their standard deviations, the MAEMM, the
-solver status, the identifiability of the parameters from these poses, and
+solver status, the identifiability of the parameters from these poses, the
+error budget of the offsets (their 1 sigma from the data against the bias the
+robot-file entries held at their values can put on them within their
+``[tolerances]``; ``error_budget`` and ``limited_by`` in the JSON:
+:mod:`zerocal_sym.identify.budget`, docs/trust.md), and
 the compensation (sign convention: ``theta_cmd = IK(P) - offset``; the actual
 joint angle is the commanded one plus the offset).  ``--json`` prints the
 results JSON that ``zerocal compensate`` reads; ``--out`` writes it
@@ -25,6 +29,7 @@ Examples:
     zerocal identify round1.csv --method tsvd
     zerocal identify round1.csv --params paper+L1,L2 --prior-std L1=0.05 --prior-std L2=0.05
     zerocal identify d.csv --robot examples/delta.toml --maemm-prior 1 0.5 -0.5 --json
+    zerocal identify d.csv --robot examples/delta_arms.toml --params auto --test-groups
 """
 from zerocal_sym.cli._identify_text import SIGMA_FRACTION  # (the verdict's fraction, in the help)
 

@@ -8,7 +8,8 @@ robot's identified set plus whole groups of the robot-file entries it holds,
 (:func:`zerocal_sym.identify.choose.expected_error`: the variance of what is
 identified, the squared bias from the tolerances of what is held).  The sets
 are searched forward: from the robot's set, add the group whose design scores
-least, while that lowers the score.  The designs of the search are
+least, while that lowers the score by more than
+:data:`zerocal_sym.identify.choose.MARGIN`.  The designs of the search are
 approximate designs (the design measure rounded to K poses, about a second
 each; :func:`zerocal_sym.design.optimize.optimize_design` with
 ``method="approx"``); the chosen set's design is then made as asked.
@@ -43,7 +44,7 @@ def choose_design_params(robot, K: int, criterion: str, cons, noise, tolerances,
         no design was found; least first), ``search``, ``model``.
     """
     from zerocal_sym.design.optimize import optimize_design
-    from zerocal_sym.identify.choose import expected_error, held_groups, set_spec
+    from zerocal_sym.identify.choose import MARGIN, expected_error, held_groups, set_spec
     from zerocal_sym.model import kinematics as kin
 
     base = robot.identified_set
@@ -76,7 +77,7 @@ def choose_design_params(robot, K: int, criterion: str, cons, noise, tolerances,
         if not trial:
             break
         top = min(trial, key=lambda r: r["expected"])
-        if not top["expected"] < best["expected"]:
+        if not top["expected"] < (1 - MARGIN) * best["expected"]:
             break
         best, current = top, tuple(top["groups"])
     rows.sort(key=lambda r: (r["expected"], len(r["groups"])))

@@ -14,8 +14,9 @@ tolerances ``t_j``, as the ``mse`` design criterion counts them)::
 and the set's score is ``sqrt(mean_i E[...])`` (the offsets' unit).
 :func:`choose_params` scores the candidate sets (:func:`candidate_sets`: the
 base set plus whole groups of held entries, ``L`` for ``L1 L2 L3``:
-:func:`zerocal_sym.model.tolerances.groups`) and returns the least.  A set
-the poses cannot identify scores infinity.
+:func:`zerocal_sym.model.tolerances.groups`) and returns the least -- of the
+sets within :data:`MARGIN` of it, the one that frees the fewest groups.  A
+set the poses cannot identify scores infinity.
 """
 from __future__ import annotations
 
@@ -32,6 +33,9 @@ from zerocal_sym.model import units
 
 #: with more groups than this the candidate sets are grown one group at a time (forward selection)
 EXHAUSTIVE_GROUPS = 8
+#: a set that frees more groups is chosen only when it lowers the score by more than this fraction: the score is
+#: first order, and every entry identified more is one more direction the data must pin down
+MARGIN = 0.05
 
 
 def held_groups(robot, base="paper") -> dict:
@@ -101,6 +105,14 @@ def expected_error(robot, theta_cmd, params, tolerances: dict, noise=None, err0=
             "identifiable": bool(np.all(np.isfinite(crlb)))}
 
 
+def parsimonious(rows: list) -> dict:
+    """Of ``rows`` (``expected``, ``groups``), the one that frees the fewest groups among those within
+    :data:`MARGIN` of the least score (then the least score)."""
+    least = min(r["expected"] for r in rows)
+    near = [r for r in rows if r["expected"] <= least * (1 + MARGIN)] if math.isfinite(least) else rows
+    return min(near, key=lambda r: (len(r["groups"]), r["expected"]))
+
+
 def choose_params(robot, theta_cmd, tolerances: dict | None = None, noise=None, base="paper", err0=None) -> dict:
     """The parameter set (``base`` plus whole groups of held entries) whose offsets' expected error at these
     poses is least.
@@ -142,12 +154,12 @@ def choose_params(robot, theta_cmd, tolerances: dict | None = None, noise=None, 
             if not trial:
                 break
             top = min(trial, key=lambda r: r["expected"])
-            if not top["expected"] < best["expected"]:
+            if not top["expected"] < (1 - MARGIN) * best["expected"]:
                 break
             best, current = top, tuple(top["groups"])
     rows.sort(key=lambda r: (r["expected"], len(r["groups"])))
     base_row = next(r for r in rows if not r["groups"])
-    best = rows[0]
+    best = parsimonious(rows)
     return {"chosen": best["params"], "base": base, "freed": best["groups"], "expected": best["expected"],
             "base_expected": base_row["expected"], "table": rows, "search": search,
             "unit": robot.errors.offset_user_unit,

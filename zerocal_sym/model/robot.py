@@ -348,7 +348,10 @@ def _check_keys(keys: dict, where) -> None:
     allowed = TOP_KEYS + geo_keys + ws_cls.keys
     for k, v in keys.items():
         if k == "tolerances" and isinstance(v, dict):
-            _check_tolerances(mech, v, where)
+            from zerocal_sym.model.tolerances import check_table
+
+            check_table(mech.errors, v, lambda key: where(key, "tolerances"), _check_number, RobotFileError,
+                        ANGLE_LIMIT_DEG)
             continue
         if k == "noise" and isinstance(v, dict):
             for kk, vv in v.items():
@@ -397,29 +400,6 @@ def _check_keys(keys: dict, where) -> None:
                                      f"got [{', '.join(_shown(x) for x in v)}]", where=where(k))
             continue
         _check_number(k, v, "mm" if k in ws_cls.keys or k == "singularity_margin" else unit(k), where)
-
-
-def _check_tolerances(mech, table: dict, where) -> None:
-    """The ``[tolerances]`` table: known keys (:func:`zerocal_sym.model.tolerances.keys`), numbers >= 0 within
-    the file's limits (mm; deg for angles).  ``where(key, table)`` names the file and the line."""
-    from zerocal_sym.model import tolerances as tl
-
-    errors = mech.errors
-
-    def here(key):
-        return where(key, "tolerances")
-
-    for k, v in table.items():
-        try:
-            names = tl.check_key(errors, k)
-        except ValueError as exc:
-            raise RobotFileError(f"[tolerances]: {exc}", where=here(k)) from None
-        units_ = {errors[n].user_unit for n in names}
-        _check_number(k, v, "deg" if units_ == {"deg"} else "mm", here)
-        if v < 0:
-            raise RobotFileError(f"[tolerances] {k} is a tolerance: >= 0, got {v!r}", where=here(k))
-        if "deg" in units_ and float(v) > ANGLE_LIMIT_DEG:
-            raise RobotFileError(f"[tolerances] {k} = {v!r} deg is beyond {ANGLE_LIMIT_DEG:g} deg", where=here(k))
 
 
 def read_toml(path, error, what: str) -> dict:

@@ -34,8 +34,8 @@ Defaults
 An entry no key names gets the default of a robot **measured by hand**:
 :data:`DEFAULT_LENGTH_TOLERANCE_MM` (0.5 mm: a caliper or a rule between
 joint centres that cannot be seen) per length and
-:data:`DEFAULT_ANGLE_TOLERANCE_DEG` (0.05 deg: the arc of 0.17 mm at 200 mm,
-an angle set by a base plate's hole pattern checked by hand) per angle.
+:data:`DEFAULT_ANGLE_TOLERANCE_DEG` (0.05 deg: an angle set by a base plate's
+hole pattern, checked by hand) per angle.
 These are 25 times the machining tolerances (0.02 mm, 0.002 deg) used before
 (``--tolerance-scale 0.04`` gives those).  The paper's robot (built in, and
 ``examples/paper_robot.toml``) carries the magnitudes of the paper's Table 2
@@ -144,3 +144,23 @@ def resolve(errors, items) -> dict:
             if n not in best or rank <= best[n][0]:
                 best[n] = (rank, v)
     return {n: (best[n][1] if n in best else default_value(errors, n)) for n in held_names(errors)}
+
+
+def check_table(errors, table: dict, where, check_number, error, angle_limit: float) -> None:
+    """A robot file's ``[tolerances]`` table: known keys (:func:`keys`), numbers >= 0 within the file's limits.
+
+    ``where(key)`` names the file and line; ``check_number(key, value, unit, where)`` is the robot file's check
+    of a number in ``unit``; ``error`` the exception raised (``error(message, where=...)``); ``angle_limit`` the
+    largest angle (deg).
+    """
+    for k, v in table.items():
+        try:
+            names = check_key(errors, k)
+        except ValueError as exc:
+            raise error(f"[tolerances]: {exc}", where=where(k)) from None
+        units_ = {errors[n].user_unit for n in names}
+        check_number(k, v, "deg" if units_ == {"deg"} else "mm", where)
+        if v < 0:
+            raise error(f"[tolerances] {k} is a tolerance: >= 0, got {v!r}", where=where(k))
+        if "deg" in units_ and float(v) > angle_limit:
+            raise error(f"[tolerances] {k} = {v!r} deg is beyond {angle_limit:g} deg", where=where(k))
