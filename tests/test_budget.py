@@ -170,6 +170,11 @@ def test_delta_arms_case_limited_by_the_robot_file_and_the_remedy(capsys, tmp_pa
     assert np.all(err_deg > 20 * np.array(d["std_zero_offsets_deg"]))  # what the fit check cannot see
     assert np.all(err_deg <= [e["robot_file_bias"] for e in d["error_budget"]])  # what the budget says
     assert all({x["name"] for x in e["dominant_entries"]} == {"L1", "L2", "L3"} for e in d["error_budget"])
+    # --tolerance overrides the file's group for one run: arms known to 1 um take their share away
+    tight = identify_json(capsys, data, "--robot", ARMS, "--tolerance", "L=0.001")
+    share = [sum(x["contribution"] for x in e["dominant_entries"]) for e in d["error_budget"]]
+    for e, t, c in zip(d["error_budget"], tight["error_budget"], share):
+        assert t["robot_file_bias"] == pytest.approx(e["robot_file_bias"] - 0.999 * c, rel=1e-6)
     # the remedy: a design for the set that frees the arms, then identify that set
     data = simulate(capsys, tmp_path / "b.csv", ARMS, "--poses", EX / "delta_arms_k12_free_L.json", *sets)
     d = identify_json(capsys, data, "--robot", ARMS, "--params", "paper+L1,L2,L3")
