@@ -383,7 +383,7 @@ def test_robot_file_numbers_too_large(capsys, tmp_path, text, pattern):
 @pytest.mark.parametrize("poses, pattern", [
     ("x_mm,y_mm\n-240,632\n0,632\n240,632\n0,782\n", "4 poses give 3 measured changes: too few"),
     ("x_mm,y_mm\n-240,632\n-120,632\n0,632\n120,632\n240,632\n-60,632\n", "lie on one straight line"),
-    ("x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n0,632\n", "pose 5: repeats the"),
+    ("x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n0,632\n", "pose 5 repeats the target of pose 1"),
     ("x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n900,782\n", "outside the workspace"),
 ])
 def test_template_refused_where_identify_would_refuse(capsys, tmp_path, files, poses, pattern):

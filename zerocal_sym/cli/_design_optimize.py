@@ -297,7 +297,7 @@ def _print_text(out, res, robot):
     region = c["region"] + (" mm" if set(pu) == {"mm"} or c["region_kind"] != "box" else "")
     print(f"constraints: region {region}; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "
-          f"{'none' if jl is None else str(jl) + ' ' + ju}; poses >= {c['min_separation_mm']:g} mm apart"
+          f"{'none' if jl is None else str(jl) + ' ' + ju}; distinct poses >= {c['min_separation_mm']:g} mm apart"
           + ("" if set(pu) == {"mm"} else " (a degree counts as a mm)"))
     n = out["noise"]
     print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, {'servo' if ju == 'deg' else 'joint'} "
@@ -434,6 +434,9 @@ def _run_target(args, robot):
            "bound": "no design of fewer than K_lower_bound poses on the candidate poses reaches the target "
                     "(certificate of the optimal design measure); K is the fewest poses of the rounded designs",
            "time_s": res["time_s"]}
+    from zerocal_sym.design.replicates import revisits_entry
+
+    out.update(revisits_entry(P))  # true replicates: a pose file of the design says revisits are intended
     from zerocal_sym.identify import fisher
 
     out[k("crlb_zero_offsets")] = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise).tolist()
@@ -451,6 +454,9 @@ def _run_target(args, robot):
           f"region {region_text(cons.region)}")
     print(f"  K = {out['K']} (design CRLB {out[k('crlb_rms')]:.5g} {ju}; per offset "
           f"{', '.join(f'{v:.5g}' for v in out[k('crlb_zero_offsets')])})")
+    if out.get("revisits"):
+        print(f"  the poses are replicates of {len(np.unique(P, axis=0))} support points, never one twice in a row "
+              "(the JSON says \"revisits\": \"allowed\": its readers accept them)")
     print(f"  certified: no design of fewer than {out['K_lower_bound']} poses on the "
           f"{out['approximate']['n_candidates']} candidate poses can reach it")
     a = out["approximate"]

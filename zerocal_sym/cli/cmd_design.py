@@ -86,8 +86,8 @@ def add_arguments(p):
     p.add_argument("--joint-limits-mm", nargs="+", type=float, metavar="MM", default=None,
                    help="--joint-limits spelt with its unit (prismatic joints)")
     p.add_argument("--min-separation", type=float, default=1.0, metavar="MM",
-                   help="min distance between two poses in mm; for a pose with orientations a degree counts as a "
-                        "mm (--optimize; default 1)")
+                   help="min distance between two distinct poses in mm (a replicate is the same pose again); for "
+                        "a pose with orientations a degree counts as a mm (--optimize; default 1)")
     p.add_argument("--noise", choices=["default", "paper", "scale-only", "servo-only", "joint-only"],
                    default="default",
                    help="noise model of the Fisher-information criteria (--optimize): the robot's (default: its "

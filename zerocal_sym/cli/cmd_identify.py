@@ -88,6 +88,9 @@ def add_arguments(p):
                         f"{SIGMA_FRACTION:g} x the largest |offset|)")
     p.add_argument("--goal-deg", type=float, default=None, metavar="DEG",
                    help="the same for revolute joints, in deg")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the measurement file")
     p.add_argument("--json", action="store_true", help="print the results JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="write the results JSON here")
     p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
@@ -242,8 +245,12 @@ def run(args):
     robot = load_robot_arg(args)
     errors = robot.errors
     prior = maemm_prior_vector(robot, args.maemm_prior)
-    meas = load_measurements(args.data, robot)  # refuses data of another mechanism or robot (robot_sha256)
+    meas = load_measurements(args.data, robot, allow_revisits=args.allow_revisits)  # refuses data of another mechanism or robot (robot_sha256)
     noise = NoiseModel.named(args.noise, robot)
+    if args.loss not in (None, "l2") and noise.has_shared:
+        raise ZerocalError(f"--loss {args.loss}: a robust loss does not take the robot file's shared revisit error "
+                           f"([noise] revisit_std_mm = {noise.sigma_revisit_mm:g}): use --loss l2, or --noise "
+                           "scale-only / servo-only")
     from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
 
     auto = args.params == "auto"
@@ -384,6 +391,10 @@ def run(args):
     if res.method == "nlls":
         print(f"Ipopt: {info['solver_status']}, {info['iterations']} iterations, cost {info['cost']:.6g}, "
               f"chi2 {info['chi2']:.4g} on {info['dof']} dof; weights: {info['weighting']}")
+    if "revisits" in info:
+        from zerocal_sym.identify.revisits import describe
+
+        print(describe(info["revisits"]))
     if args.report:
         print(format_report(report))
     if args.out:

@@ -251,6 +251,9 @@ class DesignResult:
             "continuous": {k: v for k, v in self.continuous.items() if k in ("value", "runs", "time_s", "build_s")},
             "timing_s": self.timing,
         })
+        from zerocal_sym.design.replicates import revisits_entry
+
+        rep.update(revisits_entry(self.poses))  # a pose file of the design accepts its replicates
         return rep
 
 

@@ -69,12 +69,16 @@ def noise_dict(robot, noise) -> dict:
     (``sigma_servo_deg`` for revolute joints, ``sigma_joint_mm`` for prismatic ones)."""
     j = float(offsets_to_user(robot, noise.sigma_joint))
     name = "sigma_servo_deg" if robot.mechanism.joint_kind == "revolute" else okey(robot, "sigma_joint")
-    return {"sigma_scale_mm": float(noise.sigma_scale_mm), name: j}
+    out = {"sigma_scale_mm": float(noise.sigma_scale_mm), name: j}
+    if noise.sigma_revisit_mm:
+        out["sigma_revisit_mm"] = float(noise.sigma_revisit_mm)
+    return out
 
 
 def joint_sigma(robot, noise_d: dict) -> float:
     """The joint term of a :func:`noise_dict` (file units)."""
-    return next(v for k, v in noise_d.items() if k.startswith("sigma_") and k != "sigma_scale_mm")
+    return next(v for k, v in noise_d.items() if k.startswith("sigma_") and k not in ("sigma_scale_mm",
+                                                                                        "sigma_revisit_mm"))
 
 
 def noise_source(robot, noise) -> str:
@@ -99,7 +103,8 @@ def describe_noise(robot, noise) -> str:
         return "paper (Eq. 34 scale + Eq. 35 servo)"
     j = float(offsets_to_user(robot, noise.sigma_joint))
     terms = (f"scale {noise.sigma_scale_mm:g} mm per change + joint {j:g} {offset_unit(robot)} per joint per "
-             "pose")
+             "pose" + (f" + {noise.sigma_revisit_mm:g} mm per pose shared by its revisits" if noise.has_shared
+                       else ""))
     src = noise_source(robot, noise)
     return f"the robot's ({src}): {terms}" if src else terms
 

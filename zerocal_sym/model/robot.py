@@ -26,6 +26,7 @@ geometry and the workspace, in tables or (the paper's flat files) at the top::
     [noise]                           # optional: the measurement noise (default: the mechanism's, else the paper's)
     scale = 0.002                     # mm per measured change of the scale
     joint = 0.005                     # per joint per pose, in the joints' unit (deg for revolute, mm for prismatic)
+    revisit_std_mm = 0.0              # a pose's systematic error of the measured length, shared by its revisits
 
     [tolerances]                      # optional: how well each entry is known (mm; deg for angles), for the
     L = 1.0                           # error budget; an entry (L1), a group (L: L1 L2 L3) or a set (lengths);
@@ -73,7 +74,7 @@ LENGTH_LIMIT_MM = 1e6
 ANGLE_LIMIT_DEG = 360.0
 TOP_KEYS = ("name", "mechanism", "mechanism_module", "units", "singularity_margin", "home")
 TABLES = ("geometry", "workspace", "noise", "tolerances")
-NOISE_KEYS = ("scale", "joint")
+NOISE_KEYS = ("scale", "joint", "revisit_std_mm")
 
 
 @dataclass(frozen=True)
@@ -358,9 +359,13 @@ def _check_keys(keys: dict, where) -> None:
                 if kk not in NOISE_KEYS:
                     raise RobotFileError(f"unknown key '{kk}' in [noise] (allowed: {', '.join(NOISE_KEYS)})",
                                          where=where(kk))
-                _check_number(kk, vv, "mm" if kk == "scale" else ju, where)
+                _check_number(kk, vv, "mm" if kk in ("scale", "revisit_std_mm") else ju, where)
                 if vv < 0:
                     raise RobotFileError(f"[noise] {kk} is a standard deviation: >= 0, got {vv!r}", where=where(kk))
+            if v.get("revisit_std_mm", 0) > 0 and v.get("scale") == 0 and v.get("joint") == 0:
+                raise RobotFileError("[noise] revisit_std_mm needs an independent term beside it (scale or joint "
+                                     "> 0): revisits of a pose would measure exactly the same length",
+                                     where=where("revisit_std_mm"))
             continue
         if k in TABLES and isinstance(v, dict):
             inner = geo_keys if k == "geometry" else ws_cls.keys + ("shape",)
