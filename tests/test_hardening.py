@@ -372,9 +372,10 @@ def test_options_of_other_commands(capsys, tmp_path, files, argv, pattern):
     ("L = 375\nhome = [1e300, 180]", "home must be 2 finite joint angles"),
 ])
 def test_robot_file_numbers_too_large(capsys, tmp_path, text, pattern):
-    base = "\n".join(line for line in ROBOT_TOML.splitlines() if not line.startswith("L "))
+    top, table = ROBOT_TOML.split("\n[tolerances]")  # (the keys go among the top-level ones, before the table)
+    base = "\n".join(line for line in top.splitlines() if not line.startswith("L "))
     f = tmp_path / "r.toml"
-    f.write_text(base + "\n" + text + "\n")
+    f.write_text(base + "\n" + text + "\n\n[tolerances]" + table)
     for command in (["robot"], ["identify", str(EXAMPLE)]):
         one_line_error(capsys, command + ["--robot", f], pattern)
 

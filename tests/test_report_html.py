@@ -107,8 +107,12 @@ def test_the_page_of_each_mechanism_holds_the_result_files_numbers(capsys, tmp_p
     assert f"The worst reading: pose {worst['pose']} (the change from pose {worst['from_pose']})" in " ".join(
         page.sections["fit-check"].split())
     assert float(page.values["fit-check"][0]) == r["fit"]["chi2"]
-    # no error budget in identify's file: said so
-    assert "error budget: not in this result file" in page.sections["error-budget"]
+    # identify's error budget: the file's numbers, and what limits the answer
+    budget = " ".join(page.sections["error-budget"].split())
+    shown = [float(v) for v in page.values["error-budget"][:2 * m]]
+    assert shown == [v for e in r["error_budget"] for v in (e["noise_std"], e["robot_file_bias"])]
+    assert f"Limited by: {r['limited_by']}." in budget and "not in this result file" not in budget
+    assert r["error_budget"][0]["dominant_entries"][0]["name"] in budget
     # residuals: the file's RMS and, with the data, the nominal model's; the poses from the data
     rms = float(page.values["residuals"][0])
     assert math.isclose(rms, 1e3 * math.sqrt(np.mean(np.square(r["residuals_mm"]))), rel_tol=1e-12)
@@ -139,36 +143,42 @@ def _budget_result(rounds, tmp_path, mech="linear", **keys):
     return robot, data, path, r
 
 
-def test_the_error_budget_keys_are_rendered(capsys, tmp_path, rounds):
-    """A result file with an error budget (inserted here by hand): its table, its 'limited by'."""
-    budget = [{"name": f"s{k}", "noise_std": 0.01 * k, "robot_file_bias": 0.02 / k,
-               "dominant_entries": ["R1", "phi2"] if k == 1 else ["l3"]} for k in (1, 2, 3)]
-    robot, data, res, _ = _budget_result(rounds, tmp_path, error_budget=budget, limited_by="robot file")
+def test_a_result_without_an_error_budget_says_so(capsys, tmp_path, rounds):
+    """A results file written before the error budget (its keys removed here): the page says it is not there."""
+    robot, _, res = rounds["delta_linear"]
+    r = json.loads(res.read_text())
+    for key in ("error_budget", "limited_by"):
+        r.pop(key)
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(r, indent=2))
     out = tmp_path / "r.html"
-    rc, _, err = zc(capsys, "report", res, "--robot", robot, "--out", out)
+    rc, _, err = zc(capsys, "report", old, "--robot", robot, "--out", out)
     assert rc == 0, err
-    page = Page(out.read_text())
-    section = " ".join(page.sections["error-budget"].split())
-    assert "noise 1 sigma [mm]" in section and "robot-file bias [mm]" in section
-    assert "R1, phi2" in section and "Limited by: robot file." in section
-    numbers = [float(v) for v in page.values["error-budget"][:6]]
-    assert numbers == [v for e in budget for v in (e["noise_std"], e["robot_file_bias"])]
-    assert "not in this result file" not in section
+    section = " ".join(Page(out.read_text()).sections["error-budget"].split())
+    assert "error budget: not in this result file" in section
 
 
-@pytest.mark.parametrize("keys, words", [
-    ({"error_budget": [{"name": "s2", "noise_std": 0.1, "robot_file_bias": 0.1, "dominant_entries": []}] * 3},
-     "entry 1 must be an object with \"name\": \"s1\""),
-    ({"error_budget": [{"name": f"s{k}", "noise_std": -1, "robot_file_bias": 0.1, "dominant_entries": []}
-                       for k in (1, 2, 3)]}, "'noise_std' must be a finite number >= 0, in mm"),
-    ({"error_budget": [], "limited_by": "data"}, "must be a list of 3 entries"),
-    ({"limited_by": "luck"}, "key 'limited_by' must be \"data\" or \"robot file\""),
+def _edited_budget(r, k, **entry):
+    b = json.loads(json.dumps(r["error_budget"]))
+    b[k].update(entry)
+    return b
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda r: {"error_budget": [r["error_budget"][1]] * 3}, "entry 1 must be the budget of s1 (joint order)"),
+    (lambda r: {"error_budget": _edited_budget(r, 0, noise_std=-1)}, "noise_std must be a number >= 0 or null"),
+    (lambda r: {"error_budget": [], "limited_by": "data"}, "must be a list of 3 entries"),
+    (lambda r: {"limited_by": "luck"}, "key 'limited_by' must be one of"),
 ])
-def test_a_malformed_error_budget_is_one_line_and_nothing_written(capsys, tmp_path, rounds, keys, words):
-    robot, _, res, _ = _budget_result(rounds, tmp_path, **keys)
+def test_a_malformed_error_budget_is_one_line_and_nothing_written(capsys, tmp_path, rounds, edit, words):
+    robot, _, res = rounds["delta_linear"]
+    r = json.loads(res.read_text())
+    r.update(edit(r))
+    bad = tmp_path / "budget.json"
+    bad.write_text(json.dumps(r, indent=2))
     out = tmp_path / "r.html"
-    rc, _, err = zc(capsys, "report", res, "--robot", robot, "--out", out)
-    assert rc == 2 and len(err.strip().splitlines()) == 1 and words in err and str(res) in err, err
+    rc, _, err = zc(capsys, "report", bad, "--robot", robot, "--out", out)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and words in err and str(bad) in err, err
     assert not out.exists()
 
 

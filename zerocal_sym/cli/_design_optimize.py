@@ -43,8 +43,10 @@ def add_arguments(p):
                    help="exact (exchange + Ipopt), approx (the optimal design measure, rounded, with a "
                         "certificate) or auto: exact up to K = 24 (default)")
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
-                   help="tolerance of an error the identification leaves out (mm; deg for angles), repeatable; "
-                        "default: set A of Table 2 (planar), 0.02 mm per length and 0.002 deg per angle (others)")
+                   help="tolerance of an error the identification leaves out, or of a group of them (L for L1 L2 "
+                        "L3) (mm; deg for angles), repeatable; default the robot file's [tolerances], else 0.5 mm "
+                        "per length and 0.05 deg per angle (a robot measured by hand; the paper's robot: Table 2's "
+                        "set A)")
     from zerocal_sym.cli._paths import InputFile
 
     p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
@@ -154,10 +156,12 @@ def constraints_from_args(robot, args):
 
 def tolerances_from_args(robot, args):
     """Tolerances of the omitted errors (internal units) from ``--tolerance``, ``--tolerance-file``, ``--tolerance-scale``."""
+    from zerocal_sym.design.terms import design_params
     from zerocal_sym.identify.bias import make_tolerances
 
     return make_tolerances(robot, getattr(args, "tolerance", None) or [], getattr(args, "tolerance_file", None),
-                           getattr(args, "tolerance_scale", 1.0), bias_model=getattr(args, "bias_model", "rms"))
+                           getattr(args, "tolerance_scale", 1.0), params=design_params(robot),
+                           bias_model=getattr(args, "bias_model", "rms"))
 
 
 def _fmt(v, spec=".4g"):
@@ -233,6 +237,17 @@ def run(args, robot):
                                  "--method approx takes any K)")
     cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"), robot)
+    choice = None
+    if getattr(args, "choose_params", False):  # the set too: the least expected offset error at K
+        import sys
+
+        from zerocal_sym.design.choose import choose_design_params
+
+        if not args.json:
+            print(f"choosing the parameter set (approximate designs, K = {K}):", file=sys.stderr)
+        choice = choose_design_params(robot, K, args.criterion, cons, noise, tol, seed=args.seed, starts=starts,
+                                      progress=None if args.json else lambda line: print(line, file=sys.stderr))
+        robot = robot.identifying(choice["chosen"])
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
     bar = progress_bar()
     try:
@@ -245,6 +260,14 @@ def run(args, robot):
         if bar is not None:
             bar.close()
     out = res.to_dict()
+    from zerocal_sym.design.terms import design_params
+
+    out["params"] = list(design_params(robot))
+    out["params_spec"] = robot.identified_set
+    if choice is not None:
+        from zerocal_sym.io.files import json_safe
+
+        out["params_choice"] = json_safe(choice)
     out["robot"] = robot.name
     out["mechanism"] = robot.mechanism_name
     out["seed"] = args.seed
@@ -294,6 +317,14 @@ def _print_text(out, res, robot):
     pu = out.get("pose_units") or pose_units(robot)
     print(f"Optimised measurement poses: robot {out['robot']}, K = {out['K']}, criterion {crit} "
           f"({_desc(crit)})")
+    if out.get("params_choice"):
+        ch = out["params_choice"]
+        print(f"parameters chosen: {ch['chosen']} (expected offset error {_fmt(ch['expected'])} {ch['unit']} at "
+              f"its design; {ch['base']} alone {_fmt(ch['base_expected'])} {ch['unit']}; {len(ch['table'])} sets, "
+              f"{ch['search']})")
+    if out.get("params") and out["params"] != list(robot.errors.resolve("paper")):
+        print(f"designed for identifying: {', '.join(out['params'])} (then: zerocal identify ... --params "
+              f"{out['params_spec']})")
     region = c["region"] + (" mm" if set(pu) == {"mm"} or c["region_kind"] != "box" else "")
     print(f"constraints: region {region}; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "

@@ -45,7 +45,7 @@ def verdict(robot, rf, goal=None, max_offset=None) -> tuple:
     """``(text, accepted)``: the verdict of a results file, worded as ``identify``'s verdict line."""
     from types import SimpleNamespace
 
-    from zerocal_sym.cli.cmd_identify import accepted_why, offsets_sigma_text
+    from zerocal_sym.cli._identify_text import accepted_why, offsets_sigma_text
     from zerocal_sym.identify.fitcheck import DEFAULT_ALPHA, plausibility
 
     from zerocal_sym.report.contents import fit_record

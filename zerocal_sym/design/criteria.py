@@ -344,7 +344,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     vals = criterion_values(robot, P, noise, tolerances)
     t = pose_terms(robot, P)
     try:
-        crlb = fisher.crlb_zero_offsets_user(robot, t["theta"], "paper", noise).tolist()
+        crlb = fisher.crlb_zero_offsets_user(robot, t["theta"], design_params(robot), noise).tolist()
     except PoseError:
         crlb = [math.inf] * robot.m
     bias_rep = _bias_report(robot, t["theta"], noise, tolerances, crlb)
@@ -378,7 +378,7 @@ def _bias_report(robot, theta, noise, tolerances, crlb):
     from zerocal_sym.identify import bias
 
     try:
-        b = bias.tolerance_bias(robot, theta, tolerances, "paper", noise)
+        b = bias.tolerance_bias(robot, theta, tolerances, design_params(robot), noise)
     except (np.linalg.LinAlgError, ValueError):
         return None
     off = [b["params"].index(z) for z in robot.errors.zero_offsets]

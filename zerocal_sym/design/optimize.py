@@ -46,7 +46,7 @@ from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objecti
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
-from zerocal_sym.design.terms import describe_noise, noise_dict, poses_to_user
+from zerocal_sym.design.terms import describe_noise, design_params, noise_dict, poses_to_user
 
 
 # --------------------------------------------------------------------------- baseline
@@ -319,7 +319,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
       hundreds.  ``mse``: the measure is improved locally for the bias
       (:func:`zerocal_sym.design.mse.mse_measure`); ``cond``: exact only.
     * ``auto`` (default) -- ``exact`` for K <= :data:`EXACT_MAX_K` (and for
-      ``cond``), ``approx`` beyond.
+      ``cond``), ``approx`` beyond; ``approx`` at any K for a robot that
+      identifies more than its mechanism's default set
+      (``robot.identifying("paper+L1,L2,L3")``): there the exact path's
+      local search ends at designs that identify the offsets at zero errors
+      only, leaving the extra entries nearly free (the rotary Delta with its
+      upper arms freed: ``python examples/delta_arms.py``, docs/trust.md);
+      the design measure's support does not.
 
     With ``certificate`` the approximate design of the criterion (of crlb for
     mse) also gives the bound on what any K-pose design on the candidates
@@ -363,7 +369,8 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     if method not in METHODS:
         raise DesignError(f"unknown design method {method!r} (known: {', '.join(METHODS)})")
     if method == "auto":
-        method = "exact" if K <= EXACT_MAX_K or criterion == "cond" else "approx"
+        default_set = set(design_params(robot)) == set(robot.errors.resolve("paper"))
+        method = "exact" if (K <= EXACT_MAX_K and default_set) or criterion == "cond" else "approx"
     if method == "approx" and criterion == "cond":
         raise DesignError("the condition number has no approximate design (it is not concave): use the exact "
                           f"method (K <= {MAX_K_EXACT})")

@@ -266,11 +266,42 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                           prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     if robust is not None:
         _limit_outliers(res, robust, loss, K, accept_misfit)
+        _unchecked_after_removal(res, robust, loss, K, accept_misfit)
     from zerocal_sym.identify.nlls_shared import revisits_entry
 
     revisits_entry(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)
     info["time_s"] = time.perf_counter() - t0
     return res
+
+
+def _unchecked_after_removal(res, robust, loss, K, accept_misfit):
+    """Refuse a robust fit that left no spare degree of freedom once its outliers were left out.
+
+    Without a spare degree of freedom the fit check cannot test what is left
+    (any readings fit), so nothing says the readings left out were the bad
+    ones: with one reading 0.18 mm off on a Delta ring of K = 8 the Huber
+    loss left out a good one and the offsets came out 2.5 deg off with a
+    1 sigma of 0.07 deg.  ``accept_misfit`` keeps it, saying so.
+    """
+    fit = res.info["fit"]
+    if not robust["excluded_readings"] or fit.get("checked") or fit.get("dof", 1) > 0 or not res.success:
+        return
+    poses = ", ".join(map(str, robust["excluded_readings"]))
+    why = (f"the {loss} loss left out the reading(s) at pose {poses}, and the {K - 1 - len(robust['excluded_readings'])}"
+           f" readings left give no spare degree of freedom: the fit cannot be checked, so nothing shows that the "
+           "readings left out were the bad ones")
+    fit["unchecked_after_removal"] = True
+    if accept_misfit:
+        res.status = f"accepted despite misfit (unchecked: {why}); {res.status}"
+        fit["accepted_despite_misfit"] = True
+    else:
+        res.success = False
+        res.status = f"rejected: {why}"
+        fit["rejected"] = True
+    fit["diagnosis"] = (f"The {loss} loss left out the reading(s) at pose {poses}; the readings left fit any "
+                        "parameters exactly (no spare degree of freedom), so the fit is not checked. Measure more "
+                        "poses (or re-measure the pose(s) left out) and identify again; --accept-misfit keeps it "
+                        "unchecked.")
 
 
 def _limit_outliers(res, robust, loss, K, accept_misfit):

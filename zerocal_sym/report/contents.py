@@ -10,9 +10,9 @@ budget) or computed from them (the accuracy maps,
 The results file's optional ``error_budget`` (one entry per zero offset in
 joint order: ``name``, ``noise_std`` and ``robot_file_bias`` in the offset's
 unit, ``dominant_entries``: the robot-file entries dominating the bias) and
-``limited_by`` (``"data"`` or ``"robot file"``) are checked here; a malformed
-one is a :class:`~zerocal_sym.errors.DataFileError` naming the file and the
-entry.
+``limited_by`` (``"data"`` or ``"robot file"``) are checked by the results
+file's loader (:mod:`zerocal_sym.io.result_budget`); a file without them
+(written before them) says so on the page.
 """
 from __future__ import annotations
 
@@ -25,8 +25,6 @@ from zerocal_sym.errors import DataFileError
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 
-#: the values of ``limited_by``
-LIMITED_BY = ("data", "robot file")
 #: a covariance's diagonal and the file's 1 sigma of the offsets: two copies of one number (relative)
 SAME_STD_RTOL = 1e-6
 #: the residuals of the data a result was identified from, recomputed at its estimate, agree with the file's to
@@ -75,44 +73,33 @@ def offsets_covariance(robot, rf):
 
 
 def error_budget(robot, rf):
-    """The file's ``error_budget`` and ``limited_by`` checked (module docstring), or None when absent.
+    """The file's ``error_budget`` and ``limited_by`` (already checked against the rest of the file by
+    :func:`zerocal_sym.io.results.load_result`: :mod:`zerocal_sym.io.result_budget`), or None when absent.
 
     Returns
     -------
     dict or None
-        ``entries``: [{``name``, ``noise_std``, ``robot_file_bias`` (floats, the offsets' unit),
-        ``dominant_entries`` (list of str)}], ``limited_by`` (str or None), ``unit``.
+        ``entries``: [{``name``, ``noise_std`` (float or None), ``robot_file_bias`` (floats, the offsets' unit),
+        ``dominant_entries`` (list of str: each entry's name, tolerance and contribution)}], ``limited_by``
+        (str or None), ``unit``.
     """
-    raw, src = rf.raw, rf.source
+    raw = rf.raw
     budget, limited = raw.get("error_budget"), raw.get("limited_by")
     if budget is None and limited is None:
         return None
-    names = list(robot.errors.zero_offsets)
-    if limited is not None and limited not in LIMITED_BY:
-        raise DataFileError(f"key 'limited_by' must be {' or '.join(json.dumps(v) for v in LIMITED_BY)}, got "
-                            f"{json.dumps(limited)[:40]}", where=src)
-    if budget is None:
-        return {"entries": [], "limited_by": limited, "unit": rf.offset_unit}
-    if not isinstance(budget, list) or len(budget) != len(names):
-        raise DataFileError(f"key 'error_budget' must be a list of {len(names)} entries, one per zero offset "
-                            f"({', '.join(names)})", where=src)
-    entries = []
-    for k, (e, name) in enumerate(zip(budget, names)):
-        what = f"key 'error_budget' entry {k + 1}"
-        if not isinstance(e, dict) or e.get("name") != name:
-            raise DataFileError(f"{what} must be an object with \"name\": {json.dumps(name)} (joint order)", where=src)
-        for key in ("noise_std", "robot_file_bias"):
-            if not _number(e.get(key)) or e[key] < 0:
-                raise DataFileError(f"{what} ({name}): '{key}' must be a finite number >= 0, in {rf.offset_unit}, "
-                                    f"got {json.dumps(e.get(key))[:40]}", where=src)
-        dom = e.get("dominant_entries", [])
-        if not isinstance(dom, list):
-            raise DataFileError(f"{what} ({name}): 'dominant_entries' must be a list of robot-file entries",
-                                where=src)
-        entries.append({"name": name, "noise_std": float(e["noise_std"]),
-                        "robot_file_bias": float(e["robot_file_bias"]),
-                        "dominant_entries": [d if isinstance(d, str) else json.dumps(d) for d in dom]})
-    return {"entries": entries, "limited_by": limited, "unit": rf.offset_unit}
+    u = rf.offset_unit
+
+    def entry(d):
+        if isinstance(d, str):
+            return d
+        return (f"{d['name']} (+-{d['tolerance']:.3g} {d.get('unit', '')}: {d['contribution']:.3g} {u})"
+                .replace(" :", ":"))
+
+    entries = [{"name": e["name"],
+                "noise_std": None if e.get("noise_std") is None else float(e["noise_std"]),
+                "robot_file_bias": float(e["robot_file_bias"]),
+                "dominant_entries": [entry(d) for d in e.get("dominant_entries") or []]} for e in budget or []]
+    return {"entries": entries, "limited_by": limited, "unit": u}
 
 
 def tolerance_bias(rf):
