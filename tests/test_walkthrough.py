@@ -2,6 +2,7 @@
 the simulate -> identify round trip (set values recovered within the noise)."""
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -38,8 +39,8 @@ def test_walkthrough(capsys, tmp_path, monkeypatch, docs_runs):
 
     ran, problems = docs_runs.page(docs_check.parse_page(docs_check.ROOT / "docs" / "walkthrough.md"))
     assert not problems, "\n".join(problems)
-    for name in ("my_robot.toml", "design.json", "round1.csv", "result1.json", "compensation.csv", "commands.csv",
-                 "round2.csv", "result2.json"):
+    for name in ("my_robot.toml", "design.json", "round1.csv", "result1.json", "report.html", "compensation.csv",
+                 "commands.csv", "round2.csv", "result2.json"):
         shutil.copy(ran / name, tmp_path / name)
     monkeypatch.chdir(tmp_path)
     R = ("--robot", "my_robot.toml")
@@ -63,7 +64,15 @@ def test_walkthrough(capsys, tmp_path, monkeypatch, docs_runs):
     for key in ("zero_offsets_deg", "maemm_mm", "std_zero_offsets_deg", "method", "status", "covariance", "units"):
         assert key in res, key
 
-    # 5. the controller's table and the compensated commands
+    # 4, the calibration report the page writes: the accuracy the page's prose shows (data-value: the full number;
+    # the page shows it to 4 significant digits; the line the command prints is the page's console block)
+    page = Path("report.html").read_text()
+    accuracy = page[page.index('<section id="accuracy">'):]
+    before, std_at, _, after = (float(v) for v in re.findall(r'data-value="([^"]+)"', accuracy)[:4])
+    doc = (ROOT / "docs" / "walkthrough.md").read_text()
+    assert f"at most {before:.4g} mm (1σ {std_at:.4g} mm) before and at most {after:.4g} mm after" in doc
+
+    # 5. apply: the controller's table and the compensated commands
     table = Path("compensation.csv").read_text()
     assert "theta_cmd = IK(P) - offset_deg" in table
     rows = [ln.split(",") for ln in table.splitlines() if ln.startswith("theta")]

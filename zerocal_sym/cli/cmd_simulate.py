@@ -69,6 +69,9 @@ def add_arguments(p):
     p.add_argument("--frame", choices=["paper", "literal"], default=None,
                    help="how Table 2 is read with --group (default: paper = mirrored about x)")
     p.add_argument("--out", required=True, metavar="FILE.csv", type=OutputFile(), help="output measurement file")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the pose file (--poses)")
 
 
 def true_errors(args, robot):
@@ -93,7 +96,7 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.cli._common import fmt_values, format_named, poses_arg, scheme_poses, vector_arg
+    from zerocal_sym.cli._common import fmt_values, format_named, poses_arg, revisits_meta, scheme_poses, vector_arg
     from zerocal_sym.errors import PoseError
     from zerocal_sym.identify.loop import simulate_round
     from zerocal_sym.io.compensation import format_offsets
@@ -113,7 +116,7 @@ def run(args):
             from zerocal_sym.errors import ZerocalError
 
             raise ZerocalError("--n is the number of poses per boundary of a scheme: not with --poses")
-        poses, pose_what = poses_arg(robot, args.poses, None)
+        poses, pose_what = poses_arg(robot, args.poses, None, allow_revisits=args.allow_revisits)
     else:
         poses, n = scheme_poses(robot, args.scheme, args.n)
         pose_what = f"{robot.workspace.scheme_name} scheme, n = {n}"
@@ -137,6 +140,7 @@ def run(args):
         units.joint_key(robot, "true_zero_offsets"): fmt_values(offsets_user),
         "true_maemm_mm": fmt_values(maemm),
         "true_errors": format_named(robot, err).replace(" deg", "").replace(" mm", ""),
+        **revisits_meta(poses),  # the poses revisit on purpose (they were read so): the file says it
     }
     if args.group is not None:
         meas.meta["n"] = len(poses) // 2

@@ -9,6 +9,14 @@ JSON object whose ``poses`` is a list of ``[x, y(, z)]``; read by
 pose) are those of the robot's mechanism, or without a robot those of the
 default mechanism: a pose file names no mechanism, and is not matched to one
 by its columns.
+
+Read as the poses of a measurement round (``measured``: ``simulate``,
+``compensate --template``, ``compare``, ``study``), a pose may come again
+after other poses (a *revisit*: a design's replicates) when the file says so
+(a CSV's ``# revisits: allowed`` line, a JSON's ``"revisits": "allowed"``, as
+``zerocal design`` writes) or the reader is told (``allow_revisits``, the
+CLI's ``--allow-revisits``); a pose right after itself (a zero change) is
+refused either way.  Other pose lists (a command table) may repeat poses.
 """
 from __future__ import annotations
 
@@ -17,9 +25,9 @@ import math
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, ColumnMismatch, _check_header, _check_pose_numbers, _json_line,
-                                    _load_json, _read_text, _rows_to_array, _split_csv, pose_columns, read_as,
-                                    with_reading_hint)
+from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, REVISITS_ALLOWED, REVISITS_KEY, ColumnMismatch, _check_header,
+                                    _check_pose_numbers, _json_line, _load_json, _read_text, _rows_to_array,
+                                    _split_csv, pose_columns, read_as, with_reading_hint)
 
 
 def __getattr__(name):
@@ -38,7 +46,7 @@ def _is_number(x) -> bool:
         return False
 
 
-def load_poses(path, robot=None) -> np.ndarray:
+def load_poses(path, robot=None, allow_revisits: bool = False, measured: bool = False) -> np.ndarray:
     """Read a list of target positions.
 
     Either a CSV ``[pose,]x_mm,y_mm[,z_mm]`` (the columns of the robot's
@@ -52,6 +60,10 @@ def load_poses(path, robot=None) -> np.ndarray:
         If given: the columns (and the length of each JSON pose) are its
         mechanism's, and every pose must lie in its workspace (1e-6 mm);
         without: the default mechanism's.
+    allow_revisits : bool
+        Accept revisits without the file saying so (module docstring).
+    measured : bool
+        The poses of a measurement round: repeated poses checked (module docstring).
 
     Returns
     -------
@@ -83,8 +95,18 @@ def load_poses(path, robot=None) -> np.ndarray:
             raise exc
         P = np.array(v, float)
         lines = None
+        meta = {}
+        if REVISITS_KEY in obj:
+            if obj[REVISITS_KEY] != REVISITS_ALLOWED:
+                raise DataFileError(f"key '{REVISITS_KEY}' can only be '{REVISITS_ALLOWED}' (the poses revisit on "
+                                    f"purpose), got {str(obj[REVISITS_KEY])[:80]!r}",
+                                    where=f"{src}:{_json_line(text, REVISITS_KEY)}")
+            meta[REVISITS_KEY] = REVISITS_ALLOWED
     else:
-        _, _, rows = _split_csv(text, src)
+        meta, meta_lines, rows = _split_csv(text, src)
+        if meta.get(REVISITS_KEY, REVISITS_ALLOWED) != REVISITS_ALLOWED:
+            raise DataFileError(f"'# {REVISITS_KEY}:' can only be '{REVISITS_ALLOWED}' (the file revisits poses on "
+                                f"purpose), got {meta[REVISITS_KEY][:80]!r}", where=f"{src}:{meta_lines[REVISITS_KEY]}")
         example = "[pose,]" + ",".join(cols)
         if not rows:
             raise DataFileError(f"empty file: no header line and no data (expected the header {example})",
@@ -100,6 +122,12 @@ def load_poses(path, robot=None) -> np.ndarray:
         if "pose" in header:
             _check_pose_numbers(V[:, header.index("pose")], lines, src, header.index("pose") + 1)
         P = V[:, [header.index(c) for c in cols]]
+    from zerocal_sym.io.measurement_checks import check_repeats, revisits_allowed
+    from zerocal_sym.model.revisits import REVISIT_TOL
+
+    if measured:
+        check_repeats(P, REVISIT_TOL, revisits_allowed(meta, allow_revisits),
+                      lambda k: f"{src}:{lines[k]}" if lines else src, "target", lines, "pose file", json=lines is None)
     if robot is not None:
         inside = robot.workspace.contains(P, 1e-6)
         for k in np.flatnonzero(~inside)[:1]:
