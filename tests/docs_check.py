@@ -35,7 +35,8 @@ The convention (README.md, "Development", "Docs that run") in short:
 Commands run with bash in a scratch directory holding a copy of the repository's ``examples/``, ``zerocal`` and
 ``python`` the test interpreter's; a page's commands (blocks and checks, not the slow ones) run in order in one
 directory, so a command sees the files the ones before it wrote.  A check whose command ran before on the page
-reuses that output.
+reuses that output; a check whose command another page shows too, or a slow item runs, takes the session's one run
+of it in a fresh directory (so it must need nothing the page wrote before).
 """
 from __future__ import annotations
 
@@ -313,7 +314,10 @@ def line_matches(expected: str, actual: str, search: bool = False, bounds: bool 
         if tok[0] == "text":
             m = tok[1].match(act, pos)
             return bool(m) and go(t + 1, m.end())
-        if pos > 0 and (act[pos - 1].isalnum() or act[pos - 1] in "._+-"):
+        # a whole number of the output: not the tail of x59 or -0.5 (unless the page's text before it took that
+        # character: ``+-0.5``)
+        glued = t == 0 or toks[t - 1][0] == "any"
+        if glued and pos > 0 and (act[pos - 1].isalnum() or act[pos - 1] in "._+-"):
             return False
         m = _ACTUAL_NUMBER.match(act, pos)
         if not m:
@@ -514,11 +518,15 @@ def scratch(directory: Path, files=None) -> Path:
 
 
 def environment() -> dict:
-    """``zerocal`` and ``python`` of this interpreter first on the PATH; the tests' settings (no compiler, Agg)."""
+    """``zerocal`` and ``python`` of this interpreter first on the PATH; the tests' settings (no compiler, Agg), and
+    80 columns (argparse wraps ``--help`` to ``COLUMNS``, which a terminal or a CI system may set).  Bytecode is
+    written as a user's commands write it: the first command compiles a module, the later ones read it (each of
+    some 150 commands compiling the package again would double the checker's CPU time)."""
     bindir = str(Path(sys.executable).parent)
     env = dict(os.environ, PATH=bindir + os.pathsep + os.environ.get("PATH", ""), MPLBACKEND="Agg",
-               ZEROCAL_COMPILE=os.environ.get("ZEROCAL_COMPILE", "never"), PYTHONDONTWRITEBYTECODE="1")
+               ZEROCAL_COMPILE=os.environ.get("ZEROCAL_COMPILE", "never"), COLUMNS="80")
     env.pop("PYTHONPATH", None)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     return env
 
 
@@ -562,23 +570,59 @@ def command_key(text: str) -> str:
     return text.strip()
 
 
-def run_page(page: Page, directory: Path):
-    """The page's fast items in order in one directory: ``[problem]`` (empty when the page is right)."""
-    scratch(directory, page.files)
-    todo, slots = [], []  # slots: (item, command, index into todo)
+def fast_commands(page: Page, shared=frozenset()):
+    """``(todo, slots)``: the commands of the page's fast items in the order they run, and per item command
+    ``(item, command, index into todo)``.  A check whose command ran before on the page takes that run; one whose
+    command (``command_key``) is in ``shared`` takes the session's run of it (index ``None``)."""
+    todo, slots = [], []
     seen = {}
     for it in page.items:
         if it.slow:
             continue
         for c in it.commands:
-            if it.kind == "check" and command_key(c.text) in seen:
-                slots.append((it, c, seen[command_key(c.text)]))
+            key = command_key(c.text)
+            if it.kind == "check" and key in seen:
+                slots.append((it, c, seen[key]))
                 continue
-            seen.setdefault(command_key(c.text), len(todo))
+            if it.kind == "check" and key in shared:
+                slots.append((it, c, None))
+                continue
+            seen.setdefault(key, len(todo))
             slots.append((it, c, len(todo)))
             todo.append(c.text)
+    return todo, slots
+
+
+def session_commands(pages) -> frozenset:
+    """The commands (``command_key``) run once per session in a fresh directory, whose run a fast check of the same
+    command takes: those more than one page shows (in a block or a check), and those of slow checks and of slow
+    ``bash`` blocks' lines (``SharedCache.command`` runs them)."""
+    where, slow = {}, set()
+    for page in pages:
+        for it in page.items:
+            for c in it.commands:
+                where.setdefault(command_key(c.text), set()).add(page.path)
+            if it.slow and _one_run_per_command(it):
+                slow |= {command_key(c.text) for c in it.commands}
+    return frozenset(k for k, v in where.items() if len(v) > 1) | frozenset(slow)
+
+
+def _one_run_per_command(item: Item) -> bool:
+    """A slow item whose commands each run on their own (a check, one command, or a block that compares no
+    output), not a slow console block of several commands run in order."""
+    return len(item.commands) == 1 or (item.kind == "block" and all(c.expected is None for c in item.commands))
+
+
+def run_page(page: Page, directory: Path, shared=frozenset(), shared_run=None):
+    """The page's fast items in order in one directory: ``[problem]`` (empty when the page is right).
+
+    ``shared_run(text)``: the session's ``(status, stdout, stderr)`` of a command in ``shared`` (a check's command
+    that another page shows too, or a slow item: run once, in a fresh directory, for every page)."""
+    scratch(directory, page.files)
+    todo, slots = fast_commands(page, shared if shared_run else frozenset())
     results = run_commands(todo, directory) if todo else []
-    return [p for p in (judge(it, c, results[k]) for it, c, k in slots) if p]
+    return [p for p in (judge(it, c, results[k] if k is not None else shared_run(c.text)) for it, c, k in slots)
+            if p]
 
 
 class SharedCache:
@@ -588,9 +632,11 @@ class SharedCache:
     second asker waits for the first run and reads its result (and may look at the files it wrote).
     """
 
-    def __init__(self, root: Path):
+    def __init__(self, root: Path, pages=None):
         self.root = root
         root.mkdir(parents=True, exist_ok=True)
+        #: the commands run once per session in a fresh directory (a fast check of one takes that run)
+        self.shared = session_commands([parse_page(p) for p in PAGES] if pages is None else pages)
 
     def _once(self, key: str, run):
         path, lock = self.root / f"{key}.json", self.root / f"{key}.lock"
@@ -609,7 +655,7 @@ class SharedCache:
         """A slow item's ``[(status, stdout, stderr)]``, its commands run in a fresh directory; the lines of a
         slow bash block each in one of their own (they must not depend on each other), so that a check of one
         of them, on any page, takes its run."""
-        if len(item.commands) == 1 or (item.kind == "block" and all(c.expected is None for c in item.commands)):
+        if _one_run_per_command(item):
             return [self.command(c.text, files) for c in item.commands]
         key = "item-" + hashlib.sha256(json.dumps([c.text for c in item.commands]).encode()).hexdigest()[:16]
         return self._once(key, lambda d: run_commands([c.text for c in item.commands], scratch(d, files)))
@@ -630,7 +676,8 @@ class SharedCache:
     def page(self, page: Page):
         """``(directory, problems)`` of the page's fast items, run in order in ``directory``."""
         key = "page-" + re.sub(r"\W", "_", _rel(page.path))
-        problems = self._once(key, lambda d: run_page(page, d))
+        problems = self._once(key, lambda d: run_page(page, d, self.shared,
+                                                      lambda text: self.command(text, page.files)))
         return self.root / key, problems
 
 

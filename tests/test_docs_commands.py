@@ -60,6 +60,9 @@ def test_numbers_compare_at_the_digits_shown():
     # digits followed by an ellipsis: the printed number starts with them
     assert dc.line_matches("theta1,-1.0637759...,0.6377426...", "theta1,-1.0637759353196776,0.6377426986548939")[0]
     assert not dc.line_matches("x 0.637743...", "x 0.6377426986548939")[0]
+    # the page's text may take a sign before a number: "+-0.5 mm" (plus or minus), not after an ellipsis
+    assert dc.line_matches("L2 at +-0.5 mm", "L2 at +-0.5 mm")[0] and not dc.line_matches("at +-0.5", "at +-0.6")[0]
+    assert not dc.line_matches("L2 ... 0.5 mm", "L2 at +-0.5 mm")[0]
     # a sign glued to a word is text: M666 X0.120 Y-0.300
     assert dc.line_matches("M666 X0.120 Y-0.300 Z0.050", "M666 X0.120 Y-0.300 Z0.050")[0]
     # words holding digits are text: theta1, P1, a hash

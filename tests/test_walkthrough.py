@@ -2,7 +2,6 @@
 the simulate -> identify round trip (set values recovered within the noise)."""
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -64,13 +63,10 @@ def test_walkthrough(capsys, tmp_path, monkeypatch, docs_runs):
     for key in ("zero_offsets_deg", "maemm_mm", "std_zero_offsets_deg", "method", "status", "covariance", "units"):
         assert key in res, key
 
-    # 4, the calibration report the page writes: the accuracy the page's prose shows (data-value: the full number;
-    # the page shows it to 4 significant digits; the line the command prints is the page's console block)
+    # 4, the calibration report the page writes (the line it prints and the accuracy the page quotes from its
+    # data-value attributes are the docs checker's): one self-contained page
     page = Path("report.html").read_text()
-    accuracy = page[page.index('<section id="accuracy">'):]
-    before, std_at, _, after = (float(v) for v in re.findall(r'data-value="([^"]+)"', accuracy)[:4])
-    doc = (ROOT / "docs" / "walkthrough.md").read_text()
-    assert f"at most {before:.4g} mm (1σ {std_at:.4g} mm) before and at most {after:.4g} mm after" in doc
+    assert '<section id="accuracy">' in page and "<script src=" not in page and "<link " not in page
 
     # 5. apply: the controller's table and the compensated commands
     table = Path("compensation.csv").read_text()
