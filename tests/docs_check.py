@@ -32,7 +32,8 @@ The convention (README.md, "Development", "Docs that run") in short:
   that must be below X.  Every number a check compares must also appear in the page's text of the same section
   (from the heading before it to the comment), so that the prose and the check cannot drift apart.
 
-Commands run with bash in a scratch directory holding a copy of the repository's ``examples/``, ``zerocal`` and
+Commands run with bash in a scratch directory holding a copy of the repository's ``examples/`` and
+``benchmarks/``, ``zerocal`` and
 ``python`` the test interpreter's; a page's commands (blocks and checks, not the slow ones) run in order in one
 directory, so a command sees the files the ones before it wrote.  A check whose command ran before on the page
 reuses that output; a check whose command another page shows too, or a slow item runs, takes the session's one run
@@ -52,7 +53,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = ROOT / "examples"
+#: the folders a page's commands find in their scratch directory (its example files, the benchmark scripts it runs)
+COPIED = ("examples", "benchmarks")
 #: the pages the checker reads
 PAGES = [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 
@@ -508,10 +510,12 @@ def judge(item: Item, cmd: Command, result) -> str | None:
 
 # ----------------------------------------------------------------------------------------------- running
 def scratch(directory: Path, files=None) -> Path:
-    """A directory holding a copy of the repository's ``examples/`` (and the page's ``file`` blocks)."""
+    """A directory holding a copy of the repository's ``examples/`` and ``benchmarks/`` (and the page's ``file``
+    blocks)."""
     directory.mkdir(parents=True, exist_ok=True)
-    if not (directory / "examples").exists():
-        shutil.copytree(EXAMPLES, directory / "examples", ignore=shutil.ignore_patterns("__pycache__"))
+    for name in COPIED:
+        if not (directory / name).exists():
+            shutil.copytree(ROOT / name, directory / name, ignore=shutil.ignore_patterns("__pycache__"))
     for name, text in (files or {}).items():
         (directory / name).write_text(text, encoding="utf-8")
     return directory
