@@ -280,7 +280,7 @@ def run(args):
     prior = maemm_prior_vector(robot, args.maemm_prior)
     meas = load_measurements(args.data, robot)  # refuses data of another mechanism or robot (robot_sha256)
     noise = NoiseModel.named(args.noise, robot)
-    from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
+    from zerocal_sym.identify.bias import make_tolerances
 
     try:  # the tolerances of the errors left out, checked before any work
         tol_params = errors.resolve("offsets+measuring" if args.method == "tsvd" else args.params)
@@ -351,7 +351,7 @@ def run(args):
     err0 = evaluation_point(robot, meas, res, prior)
     report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=err0)
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
-    bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=err0)
+    bias = _bias_report(robot, meas, res, tol, names, noise, err0, prior, args)
     out["bias"] = bias
     if not res.success:
         if args.json:
@@ -398,8 +398,9 @@ def run(args):
           f"{res.status}")
     print_estimate(robot, res)
     zo = bias["zero_offsets"]
-    print("bias the offsets may carry from the errors left out (first order, their tolerances): worst case "
-          + ", ".join(f"{v:.4g}" for v in zo["worst_case_" + zo["unit"]]) + f" {zo['unit']}, RMS "
+    print(f"bias the offsets may carry from the errors left out ({bias['estimator']}, their tolerances): worst case "
+          "(searched on the exact model) "
+          + ", ".join(f"{v:.4g}" for v in zo["worst_case_" + zo["unit"]]) + f" {zo['unit']}, RMS (first order) "
           + ", ".join(f"{v:.4g}" for v in zo["rms_" + zo["unit"]]) + f" {zo['unit']} (--tolerance NAME=VALUE to change)")
     info = res.info
     if res.method == "nlls":
@@ -411,6 +412,32 @@ def run(args):
         print(f"wrote {args.out}")
     print(verdict_line(res, args))
     return 0
+
+
+def _bias_report(robot, meas, res, tol, names, noise, err0, prior, args) -> dict:
+    """The bias the omitted errors' tolerances may put on this method's estimate: TSVD's own operator (at its last
+    step's linearisation point, its truncation) or the weighted fit's sensitivity, linearised at the estimate
+    (TSVD's less its linearisation bias), each offset's worst case searched on the exact model
+    (:mod:`zerocal_sym.identify.bias_exact`)."""
+    import numpy as np
+
+    from zerocal_sym.identify import bias_exact
+    from zerocal_sym.identify.bias import tsvd_bias_operator
+
+    errors = robot.errors
+    if res.method == "tsvd":
+        inc = np.asarray(res.info.get("increment", np.zeros(len(names))), float)
+        lin = errors.put(prior, names, res.estimate - inc) if np.all(np.isfinite(inc)) else prior
+        op = tsvd_bias_operator(robot, meas.theta_cmd, lin, t=res.info.get("truncation"))
+        est = bias_exact.tsvd_estimator(robot, meas.theta_cmd, prior, t=args.truncation,
+                                        iterations=int(res.info.get("tsvd_iterations", 1)))
+        b = np.asarray(res.info.get("linearisation_bias", np.full(len(names), np.nan)), float)
+        if np.all(np.isfinite(b)):  # around the truth TSVD's estimate stands for: its estimate less its own bias
+            err0 = errors.put(err0, names, res.estimate - b)
+        return bias_exact.tolerance_bias_exact(robot, meas.theta_cmd, tol, names, noise, err0, est, operator=op,
+                                               estimator_name="tsvd (its unweighted, truncated operator)")
+    est = bias_exact.nlls_estimator(robot, meas.theta_cmd, names, noise, err0)
+    return bias_exact.tolerance_bias_exact(robot, meas.theta_cmd, tol, names, noise, err0, est)
 
 
 def evaluation_point(robot, meas, res, prior):
