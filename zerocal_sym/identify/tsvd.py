@@ -141,23 +141,22 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     Returns
     -------
     IdentificationResult
-        ``method = "tsvd"``, params: the zero offsets and the MAEMM.  ``covariance``
-        is that of the linear TSVD estimator ``x = A b`` (``A = V_t S_t^-1
-        U_t^T``) under the noise model, ``T A C A^T T`` with ``C`` the
-        covariance of the measured changes (:func:`zerocal_sym.identify.fisher.
-        measurement_covariance`, servo error propagated to first order) and
-        ``T`` converting ``L dth`` to ``dth``.  Without a noise model it is
-        ``s^2 T A A^T T`` with ``s^2 = ||r||^2 / (K - 1 - t)`` (white noise
-        estimated from the linear residuals), or None if ``K - 1 = t``.
-        **What TSVD leaves out is added** (``std_kind = "total"``, or
-        ``"from residuals"`` without a noise model): the linearisation bias
-        ``b = estimate - (exact-model minimum over the kept directions, Gauss-
-        Newton from the estimate)`` as ``b b^T``, and for each truncated
-        direction ``v_i`` a bias bound ``(|c_i| + 2 sd_i)^2 T v_i v_i^T T``
-        (``c_i`` its component in the full-rank exact fit, ``sd_i`` that
-        component's std); if these cannot be evaluated the std is labelled
-        ``"lower bound"``.  ``info["covariance_noise"]`` is the noise part
-        alone, ``info["std_components"]`` the three parts per parameter.
+        ``method = "tsvd"``, params: the zero offsets and the MAEMM.  ``covariance``:
+        the noise of the linear TSVD estimator ``x = A b`` (``A = T V_t S_t^-1 U_t^T``,
+        ``T`` converting ``L dth`` to ``dth``), ``A C A^T`` with ``C`` the covariance
+        of the changes at the estimate (without a noise model ``s^2 A A^T``,
+        ``s^2 = ||r||^2 / (K - 1 - t)``, or None if ``K - 1 = t``), and **what TSVD
+        leaves out**, per parameter (:mod:`~zerocal_sym.identify.tsvd_uncertainty`):
+        its linearisation bias ``b`` (``x - t*``, ``t*`` the truth its noise-free
+        data maps onto the estimate) and, for each truncated direction, a bias
+        bound; ``info["std_kinds"]`` says per
+        parameter whether its std is honest (``"total"``: ``noise^2 + b^2``,
+        the bias small and well determined) or an upper bound (``"bound"``);
+        ``std_kind`` is ``"total"`` when all are, else ``"bound"`` (``"from
+        residuals"`` without a noise model, ``"lower bound"`` if a part cannot
+        be evaluated, with ``info["std_note"]``).  ``info["covariance_noise"]``
+        is the noise part alone, ``info["std_components"]`` the parts per
+        parameter.
         ``residuals`` are the measured minus the exact-model changes at the
         estimate.  ``info``: ``singular_values``, ``truncation``,
         ``filter_factors``, ``rule``, ``kappa``, ``linear_residuals``,
