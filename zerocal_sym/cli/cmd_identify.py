@@ -158,7 +158,9 @@ def offsets_sigma_text(res, goal=None) -> str:
     kind = f" ({res.std_kind})" if getattr(res, "std_kind", None) else ""
     bounds = [n for n, k in (res.info.get("std_kinds") or {}).items() if k == "bound" and n in res.zero_offset_names]
     if bounds:  # TSVD: an offset whose linearisation bias is not known well enough has an upper bound for its std
-        kind = f" (an upper bound for {', '.join(bounds)}: the linearisation bias; --iterate removes it)"
+        truncated = res.info.get("truncation", len(res.params)) < len(res.params)
+        kind = (f" (an upper bound for {', '.join(bounds)}: " + ("the truncated directions' bias)" if truncated else
+                "TSVD's linearisation bias is not small or not known within the noise; --iterate removes it)"))
     worst = float(np.max(std))
     u = getattr(res, "offset_unit", "deg")
     if goal is not None:
@@ -429,7 +431,7 @@ def _bias_report(robot, meas, res, tol, names, noise, err0, prior, args) -> dict
         inc = np.asarray(res.info.get("increment", np.zeros(len(names))), float)
         lin = errors.put(prior, names, res.estimate - inc) if np.all(np.isfinite(inc)) else prior
         op = tsvd_bias_operator(robot, meas.theta_cmd, lin, t=res.info.get("truncation"))
-        est = bias_exact.tsvd_estimator(robot, meas.theta_cmd, prior, t=args.truncation,
+        est = bias_exact.tsvd_estimator(robot, meas.theta_cmd, prior, t=res.info.get("truncation"),
                                         iterations=int(res.info.get("tsvd_iterations", 1)))
         b = np.asarray(res.info.get("linearisation_bias", np.full(len(names), np.nan)), float)
         if np.all(np.isfinite(b)):  # around the truth TSVD's estimate stands for: its estimate less its own bias
