@@ -74,6 +74,10 @@ def _coverage(robot, truth, rounds, noise, iterations=1):
     err = np.array([r.estimate for r in res]) - robot.errors.take(truth, names)
     std = np.array([np.sqrt(np.diag(r.covariance)) for r in res])
     honest = np.array([[r.info["std_kinds"][n] == "total" for n in names] for r in res])
+    noise_sd = np.array([np.sqrt(np.diag(r.info["covariance_noise"])) for r in res])
+    # the diagnosis: the noise alone (its spread against the one propagated, how often it covers the error)
+    print("noise alone: sd(error) / noise std", np.round(np.std(err, axis=0) / np.mean(noise_sd, axis=0), 3),
+          "; |error| <= 2 noise std", np.round(np.mean(np.abs(err) <= 2 * noise_sd, axis=0), 4))
     return names, np.mean(np.abs(err) <= 2 * std, axis=0), honest.mean(axis=0)
 
 
