@@ -93,15 +93,19 @@ def tsvd_estimator(robot, theta_cmd, prior=None, t=None, iterations: int = 1):
     return estimate
 
 
-#: up to this many omitted errors every corner of the tolerance box is evaluated; beyond, the two first-order
-#: worst corners of each offset
+#: up to this many omitted errors every corner of the tolerance box is evaluated (if the poses allow, below);
+#: beyond, the two first-order worst corners of each offset
 EXHAUSTIVE_MAX = 8
+#: every corner only while (corners + 1) x K stays below this many poses
+EXHAUSTIVE_POSES = 50_000
+#: the estimator sees at most this many poses at once (data sets per call: this over K)
+CHUNK_POSES = 100_000
 
 
-def _candidates(S, rows, t):
+def _candidates(S, rows, t, K):
     """Corners to evaluate (c, r) and, per row of ``rows``, the indices of its own candidates."""
     r = t.size
-    if r <= EXHAUSTIVE_MAX:
+    if r <= EXHAUSTIVE_MAX and (2 ** r + 1) * K <= EXHAUSTIVE_POSES:
         C = np.array(np.meshgrid(*[(-1.0, 1.0)] * r, indexing="ij")).reshape(r, -1).T * t
         return C, [np.arange(len(C))] * len(rows)
     C, own = [], []
@@ -114,8 +118,8 @@ def _candidates(S, rows, t):
 def exact_corner_bias(robot, theta_cmd, S, omitted, tolerances, names, err0, estimator) -> dict:
     """The worst bias of each zero offset over corners of the tolerance box, on the exact model.
 
-    Up to :data:`EXHAUSTIVE_MAX` omitted errors every corner; beyond, for each offset its two first-order worst
-    corners ``+-sign(S_i) t``.
+    Up to :data:`EXHAUSTIVE_MAX` omitted errors (and :data:`EXHAUSTIVE_POSES` poses over all corners) every
+    corner; beyond, for each offset its two first-order worst corners ``+-sign(S_i) t``.
 
     Parameters
     ----------
@@ -145,16 +149,17 @@ def exact_corner_bias(robot, theta_cmd, S, omitted, tolerances, names, err0, est
     rows = [list(names).index(n) for n in off]
     om = [errors.index(n) for n in omitted]
     t = np.asarray(tolerances, float)
-    C, own = _candidates(np.asarray(S, float), rows, t)
+    th = np.atleast_2d(theta_cmd)
+    C, own = _candidates(np.asarray(S, float), rows, t, th.shape[0])
     truths = [np.array(err0, float, copy=True)]  # the baseline: what the estimator makes of the data without them
     for c in C:
         err = np.array(err0, float, copy=True)
         err[om] = err[om] + c
         truths.append(err)
-    th = np.atleast_2d(theta_cmd)
     with np.errstate(all="ignore"):
         R = np.array([VirtualPlant(robot, err).measure(th) for err in truths])
-    est = np.asarray(estimator(R), float)
+    step = max(1, CHUNK_POSES // th.shape[0])
+    est = np.concatenate([np.asarray(estimator(R[i:i + step]), float) for i in range(0, len(R), step)])
     out = {}
     for n, i, idx in zip(off, rows, own):
         b = est[1 + idx, i] - est[0, i]
