@@ -113,7 +113,7 @@ def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
     which, and which gauge-fixing parameters to leave out.  ``poses``: how the
     phrase names the poses (default ``these K poses``).
     """
-    from zerocal_sym.identify.identifiability import identifiability_report
+    from zerocal_sym.identify.identifiability import identifiability_report, null_direction_text
 
     names = list(names)
     K, p = len(theta_cmd), len(names)
@@ -130,12 +130,17 @@ def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
         why = (f"the distances do not see the rigid motion{'s' if len(motions) > 1 else ''} {', '.join(motions)}"
                + (f"; leave {', '.join(fix)} out of the parameters to fix {'them' if len(motions) > 1 else 'it'}"
                   if fix else ""))
+    elif p - r <= 2:  # each null direction by its amounts in file units: what a reader can picture
+        combos = "; ".join(null_direction_text(robot, comb) for comb in rep["null_space"])
+        why = (f"{'this combination changes' if p - r == 1 else 'these combinations change'} no measured distance: "
+               f"{combos}; identify fewer parameters or measure other poses")
     else:
         bad = [n for n, ok in rep["identifiable"].items() if not ok]
-        why = (f"{p - r} unobservable combination{'s' if p - r > 1 else ''} of "
+        why = (f"{p - r} unobservable combinations of "
                + ", ".join(bad[:6]) + (f" and {len(bad) - 6} more" if len(bad) > 6 else "")
                + "; identify fewer parameters or measure other poses")
     return f"the {p} parameters are not identifiable from {poses} (rank {r} of {p}: {why})"
+
 
 
 # --------------------------------------------------------------------------- per command

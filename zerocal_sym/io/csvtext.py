@@ -38,7 +38,8 @@ class ColumnMismatch(DataFileError):
 MECHANISM_KEY = "mechanism"
 #: the metadata keys zerocal reads: one value each (a second line with another value is an error); other
 #: ``# key: value`` lines are kept and ignored, and may repeat
-READ_META_KEYS = (MECHANISM_KEY, "robot_sha256", "compensation_deg", "true_errors")
+READ_META_KEYS = (MECHANISM_KEY, "robot_sha256", "compensation_deg", "compensation_mm", "true_errors", "region",
+                  "region_singularity_margin")
 
 #: plausibility limits of the cells (anything beyond is a unit or typing error)
 ANGLE_LIMIT_DEG = 3600.0
