@@ -84,3 +84,11 @@ def test_one_value_per_compensation_line_in_mm(tmp_path, capsys):
     data.write_text(text.replace("# compensation_mm: 0 0 0\n", "# compensation_mm: 0 0 0\n# compensation_mm: 1 1 1\n"))
     _, err = zc(capsys, "identify", data, "--robot", LINEAR, expect=2)
     assert "'# compensation_mm:' given twice with different values" in one_line(err)
+
+
+@pytest.mark.parametrize("argv", [("compare", "--set", "theta1=1", "--trials", "1000000000000"),
+                                  ("design", "--optimize", "--verify", "1000000000000")])
+def test_a_monte_carlo_larger_than_memory_holds_is_refused_before_any_work(capsys, argv):
+    """``compare --trials 1e12`` grew by about 60 MB/s with no output: refused at once, pointing to a study."""
+    _, err = zc(capsys, *argv, expect=2)
+    assert "must be" in one_line(err) and "1,000,000" in err and "zerocal study" in err

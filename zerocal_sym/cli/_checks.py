@@ -36,6 +36,9 @@ from zerocal_sym.errors import ZerocalError
 
 #: the most poses per boundary of a scheme (--n): K = 2n = 100,000 poses
 MAX_N = 50_000
+#: Monte Carlo trials at most of compare (per group) and design --verify: every trial's estimates are held in
+#: memory until the summary; a larger Monte Carlo is a study (chunked on disk, resumable)
+MAX_TRIALS = 1_000_000
 #: a MAEMM prior beyond this is not a manufacturing error of the measuring mechanism (mm)
 MAEMM_PRIOR_LIMIT_MM = 1000.0
 
@@ -244,9 +247,17 @@ def _simulate(args) -> None:
     _n(args)
 
 
+def _trials(args, dest: str, lo: int) -> None:
+    v = getattr(args, dest, None)
+    if v is not None and not lo <= v <= MAX_TRIALS:
+        raise ZerocalError(f"{_opt(dest)} must be {lo}..{MAX_TRIALS:,} (every trial's estimates are held in memory; "
+                           "a larger Monte Carlo is a study, chunked on disk and resumable: zerocal study)")
+
+
 def _compare(args) -> None:
     _seed(args)
     _n(args)
+    _trials(args, "trials", 1)
     methods = [m.strip() for m in str(args.methods).split(",") if m.strip()]
     if not methods:
         raise ZerocalError("--methods: no method given (a comma-separated subset of tsvd-loop, tsvd, nlls, "
@@ -285,6 +296,7 @@ def _design(args) -> None:
             raise ZerocalError(f"{_opts(bad)}: where the --verify Monte Carlo runs: give --verify N")
     _seed(args)
     _n(args)
+    _trials(args, "verify", 0)
     _maemm_prior(args)
 
 
