@@ -122,3 +122,12 @@ def test_a_round_s_region_lines_are_checked(tmp_path, capsys, edit, message):
     data.write_text(data.read_text().replace(*edit, 1))
     _, err = zc(capsys, "identify", data, expect=2)
     assert message in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_compare_s_loop_stops_at_verify_s_threshold_in_the_joints_unit(capsys):
+    """compare's loop and verify judge a compensation alike: mu0 0.02 mm on a linear Delta (was 0.1, read as mm)."""
+    linear = str(ROOT / "examples" / "linear_delta.toml")
+    for robot, key, mu0 in ((linear, "mu0_mm", 0.02), (DELTA, "mu0_deg", 0.1)):
+        out, _ = zc(capsys, "compare", "--robot", robot, "--set", f"{'s1' if robot == linear else 'theta1'}=0.5",
+                    "--trials", "1", "--methods", "tsvd-loop", "--quiet", "--json")
+        assert json.loads(out)["settings"][key] == mu0

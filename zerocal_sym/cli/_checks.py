@@ -272,7 +272,7 @@ def _compare(args) -> None:
                            f"methods identify the zero offsets and the MAEMM (--methods {','.join(methods)})")
     if args.max_iter is not None and args.max_iter < 1:
         raise ZerocalError(f"--max-iter must be >= 1 (identifications per loop), got {args.max_iter}")
-    _positive(args, "mu0", " of degrees")
+    _positive(args, "mu0", " (in the joints' unit)")
 
 
 def _design(args) -> None:
