@@ -1,6 +1,7 @@
 """Refusals that say where and why, on the prismatic mechanisms: a true robot that does not assemble names its pose;
 a pose set that cannot identify the mechanism's set names its null direction in the errors' units, in every
 command; a robot file's mechanism module is an input no output may overwrite; one value per compensation line."""
+import json
 from pathlib import Path
 
 import pytest
@@ -92,3 +93,19 @@ def test_a_monte_carlo_larger_than_memory_holds_is_refused_before_any_work(capsy
     """``compare --trials 1e12`` grew by about 60 MB/s with no output: refused at once, pointing to a study."""
     _, err = zc(capsys, *argv, expect=2)
     assert "must be" in one_line(err) and "1,000,000" in err and "zerocal study" in err
+
+
+def test_verify_says_when_mu0_is_below_what_the_round_resolves(tmp_path, capsys):
+    """A mu0 under the new offsets' 1 sigma is a test the round passes only by chance: said, and in the JSON."""
+    truth = ("--set", "s1=0.8", "--set", "s2=-0.5", "--set", "s3=0.3")
+    d1, d2, res = tmp_path / "d1.csv", tmp_path / "d2.csv", tmp_path / "r.json"
+    zc(capsys, "simulate", "--robot", LINEAR, *truth, "--out", d1)
+    zc(capsys, "identify", d1, "--robot", LINEAR, "--out", res)
+    est = json.loads(res.read_text())["zero_offsets_mm"]
+    zc(capsys, "simulate", "--robot", LINEAR, *truth, "--compensation", *map(str, est), "--seed", "1", "--out", d2)
+    rc = main(["verify", str(res), str(d2), "--robot", LINEAR, "--json"])
+    report = json.loads(capsys.readouterr().out)["verification"]
+    assert not report["mu0_below_std"] and report["mu0_mm"] > report["std_rms_new_offsets_mm"] > 0, report
+    assert rc == (0 if report["passed"] else 1)
+    out, _ = zc(capsys, "verify", res, d2, "--robot", LINEAR, "--mu0", "0.001", expect=1)
+    assert "note: mu0 = 0.001 mm is not above the new offsets' uncertainty" in out, out
