@@ -242,6 +242,11 @@ def _verify(args) -> None:
     _trust(args)
 
 
+def _report(args) -> None:
+    _positive(args, "goal", " (in the joints' unit)")
+    _positive(args, "max_offset", " (in the joints' unit)")
+
+
 def _simulate(args) -> None:
     _seed(args)
     _n(args)
@@ -325,7 +330,8 @@ def _study(args) -> None:
 
 
 CHECKS = {"identify": _identify, "compensate": _compensate, "verify": _verify, "simulate": _simulate,
-          "compare": _compare, "design": _design, "reproduce": _reproduce, "regen": _regen, "study": _study}
+          "compare": _compare, "design": _design, "reproduce": _reproduce, "regen": _regen, "study": _study,
+          "report": _report}
 
 
 def check_args(args) -> None:

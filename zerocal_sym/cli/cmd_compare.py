@@ -73,6 +73,9 @@ def add_arguments(p):
     from zerocal_sym.cli import _parallel
 
     _parallel.add_arguments(p)
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the pose file (--poses)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="also write the JSON here")
 
@@ -107,7 +110,7 @@ def run(args):
         truth = robot.errors.from_user(parse_named_values(args.set, robot, "--set"))
     if args.n is not None and args.poses is not None and args.poses not in scheme_names():
         raise ZerocalError("--n is the number of poses per boundary of a scheme: not with a pose file")
-    poses, _ = poses_arg(robot, args.poses, args.n)
+    poses, _ = poses_arg(robot, args.poses, args.n, allow_revisits=args.allow_revisits)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     try:
         params = robot.errors.resolve(args.params)

@@ -70,6 +70,9 @@ def add_arguments(p):
     p.add_argument("--frame", choices=["paper", "literal"], default=None,
                    help="how Table 2 is read with --group (default: paper = mirrored about x)")
     p.add_argument("--out", required=True, metavar="FILE.csv", type=OutputFile(), help="output measurement file")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the pose file (--poses)")
 
 
 def true_errors(args, robot):
@@ -94,7 +97,7 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.cli._common import fmt_values, format_named, scheme_poses, vector_arg
+    from zerocal_sym.cli._common import fmt_values, format_named, revisits_meta, scheme_poses, vector_arg
     from zerocal_sym.errors import PoseError
     from zerocal_sym.identify.loop import simulate_round
     from zerocal_sym.io.compensation import format_offsets
@@ -116,7 +119,7 @@ def run(args):
             raise ZerocalError("--n is the number of poses per boundary of a scheme: not with --poses")
         from zerocal_sym.io.poses import load_design_poses
 
-        poses, region = load_design_poses(args.poses, robot)
+        poses, region = load_design_poses(args.poses, robot, args.allow_revisits, measured=True)
         pose_what = str(args.poses)
     else:
         poses, n = scheme_poses(robot, args.scheme, args.n)
@@ -150,6 +153,7 @@ def run(args):
         units.joint_key(robot, "true_zero_offsets"): fmt_values(offsets_user),
         "true_maemm_mm": fmt_values(maemm),
         "true_errors": format_named(robot, err).replace(" deg", "").replace(" mm", ""),
+        **revisits_meta(poses),  # the poses revisit on purpose (they were read so): the file says it
         **(region or {}),  # poses of a design's own region, outside the workspace: the region travels with them
     }
     if args.group is not None:

@@ -38,6 +38,9 @@ def add_arguments(p):
     p.add_argument("--mu0", type=float, default=None,
                    help="threshold of the compensation accuracy mu, in the joints' unit (default 0.1 deg, the "
                         "paper's, for revolute joints; 0.02 mm for prismatic ones)")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the measurement file")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(),
                    help="write the new result (readable by compensate and verify), atomically")
@@ -126,7 +129,7 @@ def run(args):
 
         print(f"zerocal verify: refused {args.result}: {'; '.join(reasons)}", file=sys.stderr)
         return 1
-    meas = load_measurements(args.data, robot)
+    meas = load_measurements(args.data, robot, allow_revisits=args.allow_revisits)
     comp_key = units.joint_key(robot, "compensation")
     declared = parse_offsets(meas.meta.get(comp_key), robot.m)
     if declared is not None and np.max(np.abs(declared - applied.zero_offsets_user)) > 1e-4:

@@ -249,7 +249,25 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
                           fitcheck.DEFAULT_ALPHA if fit_alpha is None else fit_alpha, accept_misfit,
                           evaluated_at=honest["_evaluated_at"])
     res.info["fit"]["chi2_at_estimate"] = honest["_chi2_at_estimate"]
+    _revisits(res, robot, th, exact, np.asarray(info["fit_point"]) * exact.scale)
     return res
+
+
+def _revisits(res, robot, th, exact, z):
+    """``info["revisits"]`` when the round revisits a pose (:func:`zerocal_sym.identify.revisits.revisit_report`,
+    at the fit check's point)."""
+    from zerocal_sym.identify.revisits import has_revisits, revisit_report
+
+    if not has_revisits(robot, th):
+        return
+    try:
+        e, A = exact.raw(z)
+        rep = revisit_report(robot, th, e, A, exact.noise, exact.robot.errors.put(exact.prior_q, exact.names,
+                                                                                   z / exact.scale))
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+        rep = {"reason": f"not estimated: {exc}"}
+    if rep is not None:
+        res.info["revisits"] = rep
 
 
 def _estimate(errors, names, prior, sol, s, T, P, maemm_prior):

@@ -9,6 +9,14 @@ JSON object whose ``poses`` is a list of ``[x, y(, z)]``; read by
 pose) are those of the robot's mechanism, or without a robot those of the
 default mechanism: a pose file names no mechanism, and is not matched to one
 by its columns.
+
+Read as the poses of a measurement round (``measured``: ``simulate``,
+``compensate --template``, ``compare``, ``study``), a pose may come again
+after other poses (a *revisit*: a design's replicates) when the file says so
+(a CSV's ``# revisits: allowed`` line, a JSON's ``"revisits": "allowed"``, as
+``zerocal design`` writes) or the reader is told (``allow_revisits``, the
+CLI's ``--allow-revisits``); a pose right after itself (a zero change) is
+refused either way.  Other pose lists (a command table) may repeat poses.
 """
 from __future__ import annotations
 
@@ -17,9 +25,9 @@ import math
 import numpy as np
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, ColumnMismatch, _check_header, _check_pose_numbers, _json_line,
-                                    _load_json, _read_text, _rows_to_array, _split_csv, pose_columns, read_as,
-                                    with_reading_hint)
+from zerocal_sym.io.csvtext import (LENGTH_LIMIT_MM, REVISITS_ALLOWED, REVISITS_KEY, ColumnMismatch, _check_header,
+                                    _check_pose_numbers, _json_line, _load_json, _read_text, _rows_to_array,
+                                    _split_csv, pose_columns, read_as, with_reading_hint)
 
 
 def __getattr__(name):
@@ -38,12 +46,12 @@ def _is_number(x) -> bool:
         return False
 
 
-def load_poses(path, robot=None) -> np.ndarray:
+def load_poses(path, robot=None, allow_revisits: bool = False, measured: bool = False) -> np.ndarray:
     """The poses of :func:`load_design_poses` (without the region they carry)."""
-    return load_design_poses(path, robot)[0]
+    return load_design_poses(path, robot, allow_revisits, measured)[0]
 
 
-def load_design_poses(path, robot=None) -> tuple:
+def load_design_poses(path, robot=None, allow_revisits: bool = False, measured: bool = False) -> tuple:
     """Read a list of target positions, and the design region they carry if they leave the workspace.
 
     Either a CSV ``[pose,]x_mm,y_mm[,z_mm]`` (the columns of the robot's
@@ -61,6 +69,10 @@ def load_design_poses(path, robot=None) -> tuple:
         assembly mode (FK returns the pose) and at least the design's
         singularity margin from a singular configuration; without: the
         default mechanism's.
+    allow_revisits : bool
+        Accept revisits without the file saying so (module docstring).
+    measured : bool
+        The poses of a measurement round: repeated poses checked (module docstring).
 
     Returns
     -------
@@ -100,8 +112,18 @@ def load_design_poses(path, robot=None) -> tuple:
         P = np.array(v, float)
         lines = None
         cons = obj.get("constraints")
+        meta = {}
+        if REVISITS_KEY in obj:
+            if obj[REVISITS_KEY] != REVISITS_ALLOWED:
+                raise DataFileError(f"key '{REVISITS_KEY}' can only be '{REVISITS_ALLOWED}' (the poses revisit on "
+                                    f"purpose), got {str(obj[REVISITS_KEY])[:80]!r}",
+                                    where=f"{src}:{_json_line(text, REVISITS_KEY)}")
+            meta[REVISITS_KEY] = REVISITS_ALLOWED
     else:
-        _, _, rows = _split_csv(text, src)
+        meta, meta_lines, rows = _split_csv(text, src)
+        if meta.get(REVISITS_KEY, REVISITS_ALLOWED) != REVISITS_ALLOWED:
+            raise DataFileError(f"'# {REVISITS_KEY}:' can only be '{REVISITS_ALLOWED}' (the file revisits poses on "
+                                f"purpose), got {meta[REVISITS_KEY][:80]!r}", where=f"{src}:{meta_lines[REVISITS_KEY]}")
         example = "[pose,]" + ",".join(cols)
         if not rows:
             raise DataFileError(f"empty file: no header line and no data (expected the header {example})",
@@ -118,6 +140,12 @@ def load_design_poses(path, robot=None) -> tuple:
             _check_pose_numbers(V[:, header.index("pose")], lines, src, header.index("pose") + 1)
         P = V[:, [header.index(c) for c in cols]]
         cons = None
+    from zerocal_sym.io.measurement_checks import check_repeats, revisits_allowed
+    from zerocal_sym.model.revisits import REVISIT_TOL
+
+    if measured:
+        check_repeats(P, REVISIT_TOL, revisits_allowed(meta, allow_revisits),
+                      lambda k: f"{src}:{lines[k]}" if lines else src, "target", lines, "pose file", json=lines is None)
     P = pose_from_user(mech, P)  # orientations are in degrees in the file (roll_deg, ...), radians inside
     region = None
     if robot is not None:
