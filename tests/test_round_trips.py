@@ -131,3 +131,10 @@ def test_compare_s_loop_stops_at_verify_s_threshold_in_the_joints_unit(capsys):
         out, _ = zc(capsys, "compare", "--robot", robot, "--set", f"{'s1' if robot == linear else 'theta1'}=0.5",
                     "--trials", "1", "--methods", "tsvd-loop", "--quiet", "--json")
         assert json.loads(out)["settings"][key] == mu0
+
+
+def test_compare_s_table_names_prismatic_offsets_by_their_joints(capsys):
+    """The linear Delta's columns are ds1, ds2, ds3 [mm] (not dth1 ... in mm); the angles keep dth1, dth2 [deg]."""
+    out, _ = zc(capsys, "compare", "--robot", ROOT / "examples" / "linear_delta.toml", "--set", "s1=0.5", "--trials",
+                "1", "--methods", "tsvd", "--quiet")
+    assert "bias ds1,ds2,ds3 [mm]" in out and "dth" not in out, out
