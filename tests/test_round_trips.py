@@ -95,12 +95,14 @@ def test_a_reachable_region_design_travels_with_its_poses(tmp_path, capsys):
     d.write_text(json.dumps(REACHABLE_DESIGN))
     truth = ("--set", "theta1=1", "--set", "theta2=-0.5", "--noise", "none")
     zc(capsys, "simulate", "--poses", d, *truth, "--out", data)
-    assert "# region: reachable set within" in data.read_text() and "# region_singularity_margin: 0.2" in data.read_text()
+    text = data.read_text()
+    assert "# region: reachable set within" in text and "# region_singularity_margin: 0.2" in text
     zc(capsys, "identify", data, "--out", res)
     np.testing.assert_allclose(offsets(res, "deg"), [1, -0.5], atol=EXACT)
     zc(capsys, "compensate", res, "--poses", d, "--template", "--out", tmp_path / "t.csv")
     assert "# region: reachable set within" in (tmp_path / "t.csv").read_text()
-    zc(capsys, "simulate", "--poses", d, *truth, "--compensation", *(repr(float(v)) for v in offsets(res, "deg")), "--out", round2)
+    applied = [repr(float(v)) for v in offsets(res, "deg")]
+    zc(capsys, "simulate", "--poses", d, *truth, "--compensation", *applied, "--out", round2)
     out, _ = zc(capsys, "verify", res, round2, "--noise", "none")
     assert "PASS" in out, out
     plain = tmp_path / "plain.json"  # the same poses without the design's region: outside the workspace

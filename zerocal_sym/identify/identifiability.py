@@ -227,7 +227,8 @@ def null_space_phrase(robot, theta_cmd, names, err0=None) -> str:
     if not null:
         return ""
     if rep["null_space_rigid"]:
-        return "the distances do not see the rigid motion(s) " + ", ".join(l for ls in rep["null_space_gauge"] for l in ls)
+        motions = [label for labels in rep["null_space_gauge"] for label in labels]
+        return "the distances do not see the rigid motion(s) " + ", ".join(motions)
     if len(null) > 2:
         return f"{len(null)} combinations change no measured distance"
     return ("this combination changes" if len(null) == 1 else "these combinations change") + \
