@@ -195,10 +195,14 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     b = readings[1:] - np.diff(lam)
     s = np.linalg.svd(G, compute_uv=False)
     if s[-1] <= RANK_RTOL * s[0]:
+        from zerocal_sym.identify.identifiability import null_space_phrase
+
         rank = int(np.sum(s > RANK_RTOL * s[0]))
+        why = null_space_phrase(robot, th, names, err0=prior)
         raise IdentificationError(
-            f"identification matrix G has rank {rank} < {p}: the measuring-mechanism vectors of the poses "
-            "are degenerate, the offsets and the MAEMM cannot be identified", where=meas.source)
+            f"identification matrix G has rank {rank} < {p}: the offsets and the MAEMM cannot be identified from "
+            f"these poses ({why or 'the measuring-mechanism vectors of the poses are degenerate'}); measure other "
+            "poses", where=meas.source)
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if spread[1] <= COLLINEAR_RTOL * spread[0]:
         raise IdentificationError(
