@@ -46,7 +46,7 @@ from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objecti
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
-from zerocal_sym.design.terms import describe_noise, noise_dict, poses_to_user
+from zerocal_sym.design.terms import describe_noise, design_params, noise_dict, poses_to_user
 
 
 # --------------------------------------------------------------------------- baseline
@@ -251,6 +251,9 @@ class DesignResult:
             "continuous": {k: v for k, v in self.continuous.items() if k in ("value", "runs", "time_s", "build_s")},
             "timing_s": self.timing,
         })
+        from zerocal_sym.design.replicates import revisits_entry
+
+        rep.update(revisits_entry(self.poses))  # a pose file of the design accepts its replicates
         return rep
 
 
@@ -298,7 +301,7 @@ def _certificate(ad, criterion, value, K, design_value_crlb=None):
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
                     exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None,
-                    method: str = "auto", certificate: bool = True) -> DesignResult:
+                    method: str = "auto", certificate: bool = True, progress=None) -> DesignResult:
     """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
     Two paths (``method``):
@@ -316,7 +319,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
       hundreds.  ``mse``: the measure is improved locally for the bias
       (:func:`zerocal_sym.design.mse.mse_measure`); ``cond``: exact only.
     * ``auto`` (default) -- ``exact`` for K <= :data:`EXACT_MAX_K` (and for
-      ``cond``), ``approx`` beyond.
+      ``cond``), ``approx`` beyond; ``approx`` at any K for a robot that
+      identifies more than its mechanism's default set
+      (``robot.identifying("paper+L1,L2,L3")``): there the exact path's
+      local search ends at designs that identify the offsets at zero errors
+      only, leaving the extra entries nearly free (the rotary Delta with its
+      upper arms freed: ``python examples/delta_arms.py``, docs/trust.md);
+      the design measure's support does not.
 
     With ``certificate`` the approximate design of the criterion (of crlb for
     mse) also gives the bound on what any K-pose design on the candidates
@@ -343,6 +352,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         default :func:`zerocal_sym.identify.bias.default_tolerances`).
     method : {"auto", "exact", "approx"}
     certificate : bool
+    progress : callable, optional
+        ``progress(done, total)`` after each step (the approximate design, each exchange and Ipopt start, each
+        polish); ``done == total`` at the end.
 
     Returns
     -------
@@ -357,7 +369,8 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     if method not in METHODS:
         raise DesignError(f"unknown design method {method!r} (known: {', '.join(METHODS)})")
     if method == "auto":
-        method = "exact" if K <= EXACT_MAX_K or criterion == "cond" else "approx"
+        default_set = set(design_params(robot)) == set(robot.errors.resolve("paper"))
+        method = "exact" if (K <= EXACT_MAX_K and default_set) or criterion == "cond" else "approx"
     if method == "approx" and criterion == "cond":
         raise DesignError("the condition number has no approximate design (it is not concave): use the exact "
                           f"method (K <= {MAX_K_EXACT})")
@@ -371,10 +384,21 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     t0 = time.perf_counter()
     ad = None
     mcrit = "crlb" if criterion == "mse" else criterion
-    if method == "approx" or (certificate and criterion != "cond"):
+    base, base_label, base_note, rejected = choose_baseline(robot, K, cons)
+    with_ad = method == "approx" or (certificate and criterion != "cond")
+    total = int(with_ad) + ((criterion == "mse") + 1 if method == "approx" else
+                            exchange_starts + n_starts + (base is not None) + 2)
+    done = [0]
+
+    def step():
+        done[0] = min(done[0] + 1, total)
+        if progress is not None:
+            progress(done[0], total)
+
+    if with_ad:
         ad = approximate_design(robot, mcrit, cons, noise, tolerances=tolerances)
         timing["approximate"] = time.perf_counter() - t0
-    base, base_label, base_note, rejected = choose_baseline(robot, K, cons)
+        step()
     scheme = robot.workspace.scheme_name
     ex, cont, approx_info = {}, {}, None
     if method == "approx":
@@ -382,7 +406,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         mad = ad
         if criterion == "mse":
             mad = mse_measure(robot, ad, K, cons, noise, tolerances)
+            step()
         P, info = realize(robot, mad, K, cons, noise, tolerances, criterion)
+        step()
         timing["round_order"] = time.perf_counter() - t1
         label = "approximate +round +order"
         approx_info = mad.to_dict(K)
@@ -391,11 +417,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         approx_info["orders_tried"] = info["orders_tried"]
     else:
         t1 = time.perf_counter()
-        ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances)
+        ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances,
+                             step=step)
         timing["exchange"] = time.perf_counter() - t1
         starts = [(f"{scheme} scheme", base)] if base is not None else []
         t1 = time.perf_counter()
-        cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances)
+        cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances,
+                                 step=step)
         timing["continuous"] = time.perf_counter() - t1
         nlp = cont.pop("nlp")
         cands = [("continuous", cont["poses"], cont["objective"]), ("exchange", ex["poses"], ex["objective"])]
@@ -413,11 +441,14 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
                 polished.append((label + " +ipopt", Pp, op))
             else:
                 polished.append((label, P, _objective(robot, criterion, P, noise, tolerances)))
+            step()
         timing["order_polish"] = time.perf_counter() - t2
         polished = [c for c in polished if not check_design(robot, c[1], cons)]
         if not polished:
             raise DesignError("neither method produced a design that meets the constraints")
         label, P, _ = min(polished, key=lambda c: c[2])
+    if progress is not None and done[0] < total:  # a random start that found no feasible design: done anyway
+        progress(total, total)
     report = evaluate(robot, P, criterion, noise, cons, tolerances)
     timing["total"] = time.perf_counter() - t0
     cert = None

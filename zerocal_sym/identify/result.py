@@ -138,6 +138,8 @@ class IdentificationResult(units.DegreeViews):
             "std_kinds": dict(self.info["std_kinds"]) if isinstance(self.info, dict) and "std_kinds" in self.info
             else {n: self.std_kind for n in self.params},
             "fit": _json_ready(self.info.get("fit")) if isinstance(self.info, dict) else None,
+            **({"revisits": _json_ready(self.info["revisits"])}
+               if isinstance(self.info, dict) and "revisits" in self.info else {}),
         }
 
 

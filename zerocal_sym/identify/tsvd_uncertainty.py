@@ -49,6 +49,7 @@ import math
 import numpy as np
 
 from zerocal_sym.identify.exact_refits import _Exact
+from zerocal_sym.identify.fitstats import _noise_dict
 
 #: honest: the bias known well enough that std^2 is known to this fraction of the noise variance
 #: (``sd_b^2 + 2 sd_b |b| <= STD_TOL sigma^2``)
@@ -122,6 +123,11 @@ def tsvd_std_parts(robot, theta, readings, names, estimate, base, A, noise=None,
     r = readings - np.diff(rho, axis=1)
     plugin = -np.einsum("npk,nk->np", A, r)
     D = np.einsum("npk,nkj->npj", A, np.diff(de[:, :, idx], axis=1)) - np.eye(p)
+    if cov_noise is None and getattr(noise, "has_shared", False):  # a shared revisit error: each round's own C
+        from zerocal_sym.identify.fisher import change_covariance
+
+        cov_noise = np.array([change_covariance(robot, theta[n], noise, err0=full[n]).sandwich(A[n])
+                              for n in range(N)])
     if cov_noise is None:
         var_rho = noise.sigma_joint ** 2 * np.sum(dt ** 2, axis=2)  # (N, K): the servo error at each pose
         AD = -np.diff(A, axis=2, prepend=0.0, append=0.0)  # A @ Dm (N, p, K), Dm the (K-1) x K difference matrix
@@ -248,8 +254,7 @@ def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_nois
     r_est = exact.evaluate(z_est)[0]
     out = {"_exact": exact, "_basis": basis, "_chi2_at_estimate": float(r_est @ r_est),
            "_std_kind": "total" if noise is not None else "from residuals",
-           "prior": prior_eff.tolist(), "noise": {"sigma_scale_mm": nm.sigma_scale_mm,
-                                                  "sigma_servo_rad": nm.sigma_servo_rad},
+           "prior": prior_eff.tolist(), "noise": _noise_dict(nm),
            "fit_basis": basis.tolist(),
            "covariance_noise": None if cov_noise is None else np.asarray(cov_noise).tolist()}
     notes = []
