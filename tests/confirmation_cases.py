@@ -2,7 +2,7 @@
 (tests/test_confirmation.py).
 
 ``python tests/confirmation_cases.py`` writes ``tests/data/reference_confirmation.json``: the results as the
-code at that commit computes them.  It was written while Ipopt solved the confirmation of every converged
+code at that commit computes them, and the versions of the libraries that computed them.  It was written while Ipopt solved the confirmation of every converged
 Gauss-Newton point; the test recomputes every case now that the confirmation is Ipopt's own first-order
 test on the Jacobian and residuals already computed (Ipopt solving whenever it does not pass) and asks for
 the same statuses, word for word, and the same answers.
@@ -174,11 +174,13 @@ def run_case(case) -> dict:
 def main():
     import time
 
-    ref = {}
+    from compare_cases import versions
+
+    ref = {"versions": versions(), "cases": {}}
     for case in CASES:
         t = time.perf_counter()
-        ref[case[0]] = run_case(case)
-        print(f"{case[0]}: {time.perf_counter() - t:.2f} s  {ref[case[0]]['status'][:100]}", flush=True)
+        ref["cases"][case[0]] = run_case(case)
+        print(f"{case[0]}: {time.perf_counter() - t:.2f} s  {ref['cases'][case[0]]['status'][:100]}", flush=True)
     REFERENCE.parent.mkdir(exist_ok=True)
     REFERENCE.write_text(json.dumps(ref, sort_keys=True, separators=(",", ":")) + "\n")
     print(f"wrote {REFERENCE}")
