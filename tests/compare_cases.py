@@ -27,7 +27,7 @@ CASES = [
                                                max_iter=6)),
     ("delta", "delta", dict(trials=3, seed=4, set={"theta1": 0.8, "theta2": -0.5, "theta3": 0.3, "rMx": 0.4})),
     ("linear_delta", "linear_delta", dict(trials=3, seed=5, set={"s1": 0.4, "s2": -0.3, "s3": 0.2, "rMy": 0.3})),
-    ("hexapod", "hexapod", dict(trials=1, seed=6, max_iter=4,
+    ("hexapod", "hexapod", dict(trials=1, seed=6, max_iter=2, methods=("nlls", "nlls-loop", "nlls-seq"),
                                 set={"L1": 0.2, "L2": -0.1, "L4": 0.15, "rMz": 0.3})),
 ]
 

@@ -314,19 +314,29 @@ def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequen
 
     def identify(robot, meas, prior=None):
         kw = dict(kwargs)
-        last = state["last"]
-        if sequential and last is not None and prior is not None and last.success:
-            full = last.full_vector()
-            idx = robot.errors.indices(params)
-            if np.allclose(np.asarray(prior, float)[idx], full[idx], rtol=0, atol=1e-15) \
-                    and last.covariance is not None and np.all(np.isfinite(last.covariance)):
-                kw["prior_cov"] = last.covariance
+        cov = sequential_prior_cov(robot, params, state["last"], prior) if sequential else None
+        if cov is not None:
+            kw["prior_cov"] = cov
         res = identify_nlls(robot, meas, params=params, noise=noise, prior=prior, **kw)
         state["last"] = res
         return res
 
     identify.__name__ = f"nlls[{params}]" + ("-sequential" if sequential else "")
     return identify
+
+
+def sequential_prior_cov(robot, params, last, prior):
+    """The Gaussian prior a sequential MAP takes from the previous result ``last`` of its loop: its covariance,
+    when ``prior`` is that result's own estimate (as the calibration loop passes it) and it is a finite
+    calibration; else None."""
+    if last is None or prior is None or not last.success:
+        return None
+    full = last.full_vector()
+    idx = robot.errors.indices(params)
+    if np.allclose(np.asarray(prior, float)[idx], full[idx], rtol=0, atol=1e-15) \
+            and last.covariance is not None and np.all(np.isfinite(last.covariance)):
+        return last.covariance
+    return None
 
 
 def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
