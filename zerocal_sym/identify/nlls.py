@@ -53,7 +53,6 @@ from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, in
 from zerocal_sym.identify.nlls_banded import round_problem
 from zerocal_sym.identify.nlls_problem import get_problem
 from zerocal_sym.identify.nlls_solve import UNIT_SIGMA_MM, information, robust_stage, solve, status_line
-from zerocal_sym.model.fastcall import FastCall
 from zerocal_sym.identify.result import IdentificationResult
 
 #: losses of identify_nlls (robust ones: zerocal_sym.identify.robust)
@@ -369,11 +368,12 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     prob = get_problem(robot, theta_cmd.shape[0], names)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], scale,
                     errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
-    fs = prob.functions
-    l, b = (o.full().ravel() for o in fs["weights"](errors.take(prior_q, names) * scale, par))
+    fast = prob.fast
+    l, b = (np.array(o) for o in fast["weights"](errors.take(prior_q, names) * scale, par))
     if callbacks == "fast":
-        rfun, jfun = FastCall(fs["rfun"]), FastCall(fs["jfun"])
+        rfun, jfun = fast["rfun"], fast["jfun"]  # (one buffer per thread, outputs copied)
         return (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy()), scale
+    fs = prob.functions
     if callbacks != "plain":
         raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
     rfun, jfun = fs["rfun"], fs["jfun"]

@@ -284,7 +284,7 @@ class NllsProblem:
             fs = self.tier.get()
             self._fast = {name: FastCall(fs[name])
                           for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun",
-                                       "fit_terms") if name in fs}
+                                       "rfun", "fit_terms") if name in fs}
             self._solvers, self._batch = {}, {}
             self._version = self.tier.version
         return self.tier.get()
