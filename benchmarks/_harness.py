@@ -125,9 +125,11 @@ def spread(times: dict, num: str, den: str, kind: str = "cpu") -> tuple:
     return min(r), max(r)
 
 
-def summary(times: dict, kind_scale: float = 1e3) -> dict:
-    """Per column the medians of CPU and wall time per item (ms by default) and the passes: JSON-ready."""
-    return {n: {"cpu_ms": kind_scale * median(times, n, "cpu"), "wall_ms": kind_scale * median(times, n, "wall"),
+def summary(times: dict, unit: str = "ms") -> dict:
+    """Per column the medians of CPU and wall time per item (``cpu_ms``, ``wall_ms``; or ``unit`` "s") and the
+    passes: JSON-ready."""
+    k = {"ms": 1e3, "s": 1.0}[unit]
+    return {n: {f"cpu_{unit}": k * median(times, n, "cpu"), f"wall_{unit}": k * median(times, n, "wall"),
                 "passes": len(t["cpu"]), "items_per_pass": t["items"]} for n, t in times.items()}
 
 
