@@ -102,8 +102,13 @@ def reachable(passes):
     return {"columns": summary(t, "s"), "design_cpu_s": cpu, "design_wall_s": median(t, "design", "wall"),
             "design_over_one_ipopt_cpu": ratio(t, "design", "1 Ipopt start"), "region_cpu_s": region_cpu,
             "stages_cpu_s": out["stages"], "target_cpu_s": TARGET_CPU_S, "met": cpu < TARGET_CPU_S,
-            "crlb_rms_deg": d["crlb_rms_deg"], "baseline_crlb_rms_deg": d["paper"]["crlb_rms_deg"],
-            "certificate_bound_deg": d["certificate"]["bound"], "method": d["method"]}
+            "crlb_rms_deg": d["crlb_rms_deg"], "crlb_zero_offsets_deg": d["crlb_zero_offsets_deg"],
+            "baseline_scheme": d["baseline_scheme"], "baseline_crlb_rms_deg": d["paper"]["crlb_rms_deg"],
+            "certificate_bound_deg": d["certificate"]["bound"],
+            "efficiency_lower_bound": d["certificate"]["efficiency_lower_bound"],
+            "bias_worst_deg": max(d["bias"]["worst_case_deg"]), "bias_rms_deg": max(d["bias"]["rms_deg"]),
+            "rho_span_mm": d["rho_span_mm"], "poses_mm": [list(map(float, p)) for p in out["res"].poses],
+            "method": d["method"]}
 
 
 def table(a):
@@ -203,7 +208,11 @@ def main():
     print(f"reachable region, y >= 450 mm, K = 6, crlb: design {r['design_cpu_s']:.2f} s CPU ({r['design_wall_s']:.2f} s "
           f"wall; target < {TARGET_CPU_S} s CPU: {'met' if r['met'] else 'NOT met'}), {r['design_over_one_ipopt_cpu']:.1f} "
           f"x one Ipopt start; region {r['region_cpu_s']:.2f} s CPU (outside); CRLB {r['crlb_rms_deg']:.5f} deg "
-          f"(baseline {r['baseline_crlb_rms_deg']:.4f}, certified bound {r['certificate_bound_deg']:.5f}; {r['method']})")
+          f"per offset {[round(v, 5) for v in r['crlb_zero_offsets_deg']]}; baseline {r['baseline_scheme']} "
+          f"{r['baseline_crlb_rms_deg']:.4f}; certified bound {r['certificate_bound_deg']:.5f}, efficiency >= "
+          f"{r['efficiency_lower_bound']:.3f}; bias worst/RMS {r['bias_worst_deg']:.4f}/{r['bias_rms_deg']:.4f} deg; "
+          f"rho span {r['rho_span_mm']:.1f} mm; {r['method']})")
+    print("  poses (mm): " + "; ".join(f"({x:.1f}, {y:.1f})" for x, y in r["poses_mm"]))
     print("  stages, CPU s: " + ", ".join(f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}"
                                           for k, v in r["stages_cpu_s"].items()))
     for row in res.get("table", []):
