@@ -136,11 +136,15 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         despite misfit ...").
 
     Solution: ``N_GN`` damped Gauss-Newton iterations inside one CasADi
-    call (:mod:`zerocal_sym.identify.nlls_problem`), then one Ipopt solve from
-    that point, whose status decides ``success`` (Ipopt is the judge; from a
-    converged Gauss-Newton point it takes 0-1 iterations).  If Gauss-Newton
-    did not converge (or left the bounds) Ipopt starts at the start point
-    and, with ``reweight``, solves once more with the weights at its solution.
+    call (:mod:`zerocal_sym.identify.nlls_problem`), then Ipopt's verdict on
+    that point, whose status decides ``success`` (Ipopt is the judge): a
+    converged point without bounds that passes Ipopt's own termination test
+    at a start (:func:`~zerocal_sym.identify.nlls_solve.ipopt_accepts`, on
+    the Jacobian and residuals already computed) gets what Ipopt returns
+    there (``Solve_Succeeded``, 0 iterations); otherwise Ipopt solves from it
+    (0-1 iterations from a converged point).  If Gauss-Newton did not
+    converge (or left the bounds) Ipopt starts at the start point and, with
+    ``reweight``, solves once more with the weights at its solution.
 
     Returns
     -------
@@ -148,7 +152,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         ``method = "nlls"``; ``success`` False whenever Ipopt did not
         converge (``status`` says why) and when the fit check rejects the fit;
         ``info``: ``solver_status``, ``iterations``, ``cost``, ``chi2``,
-        ``dof``, ``time_s``, ``weighting``, ``warm_start``, ``rank``,
+        ``dof``, ``time_s``, ``weighting``, ``warm_start``, ``confirmation``
+        (``"first-order test"`` or ``"ipopt"``), ``rank``,
         ``singular_values`` (of the scaled whitened Jacobian),
         ``nonidentifiable``, ``fit`` (the fit check), ``robust`` (with a
         robust loss).  ``std_kind``: ``"total"`` (the Cramér-Rao bound at the
