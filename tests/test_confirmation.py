@@ -53,48 +53,47 @@ def _masked(text):
     return _NUMBER.sub("#", _IPOPT_SUCCESS.sub("<ipopt success>", text))
 
 
-def _close(a, b, rtol, path=""):
-    """Every number of ``b`` within ``rtol`` of ``a`` (relative to the largest entry of its vector), texts with
-    their numbers to ``rtol`` and their words the same, the rest equal."""
-    if isinstance(a, dict):
-        assert isinstance(b, dict) and set(a) == set(b), path
-        for k in a:
-            _close(a[k], b[k], rtol, f"{path}.{k}")
-    elif isinstance(a, list):
-        assert isinstance(b, list) and len(a) == len(b), path
-        if a and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in a) and \
-                all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in b):
-            x, y = np.array(a, float), np.array(b, float)
-            scale = float(np.max(np.abs(x))) if x.size else 0.0
-            assert np.max(np.abs(x - y)) <= rtol * scale, (path, a, b)
-        else:
-            for i, (x, y) in enumerate(zip(a, b)):
-                _close(x, y, rtol, f"{path}[{i}]")
-    elif isinstance(a, str):
-        assert _masked(a) == _masked(b), (path, a, b)
-        for x, y in zip(_NUMBER.findall(a), _NUMBER.findall(b)):
-            assert float(y) == pytest.approx(float(x), rel=max(rtol, 1e-2), abs=1e-300), (path, a, b)
-    elif isinstance(a, float) and isinstance(b, float):
-        assert b == pytest.approx(a, rel=rtol, abs=rtol * 1e-300), (path, a, b)
-    else:
-        assert a == b, (path, a, b)
+def _texts_agree(a, b, rtol=1e-2):
+    """The same words (Ipopt's two successful ends as one), the numbers to ``rtol`` (a status prints 3-4 digits)."""
+    if a is None or b is None:
+        return a == b
+    if _masked(a) != _masked(b):
+        return False
+    return all(float(y) == pytest.approx(float(x), rel=rtol, abs=1e-300)
+               for x, y in zip(_NUMBER.findall(a), _NUMBER.findall(b)))
+
+
+def _vectors_agree(a, b, rtol):
+    x, y = np.array(a, float), np.array(b, float)
+    fin = np.isfinite(x)
+    if x.shape != y.shape or not np.array_equal(fin, np.isfinite(y)):
+        return False
+    scale = float(np.max(np.abs(x[fin]))) if fin.any() else 0.0
+    return bool(np.all(np.abs(x[fin] - y[fin]) <= rtol * scale))
 
 
 @pytest.mark.parametrize("cid", _ids())
 def test_the_reference_set_is_unchanged(cid, monkeypatch):
     """Every case against the reference written while Ipopt solved every confirmation: on the library versions
-    that wrote it, the same bits; on others (the oldest declared versions), the same statuses word for word
-    but for Ipopt's choice between its two successful ends, and the same numbers to the Gauss-Newton stopping
-    tolerance relative to the condition of the problem (the numbers a status prints to their three digits)."""
+    that wrote it, the same bits; on others (the oldest declared versions), the same success, the same status
+    word for word but for Ipopt's choice between its two successful ends (its numbers to the digits it prints),
+    the same rank and fit verdict, the estimate and covariance to the Gauss-Newton stopping tolerance relative
+    to the condition of the problem."""
     new = _run(cid, "test", monkeypatch)
     ref = REFERENCE["cases"][cid]
     if SAME_VERSIONS:
         assert new == ref
         return
+    # other builds (the oldest declared versions): the answers and the verdicts; the point is defined to the
+    # Gauss-Newton tolerance (1e-8 mm in scaled units) and moves with the condition of the whitened Jacobian:
+    # 1e-5 relative covers kappa up to 1e3 at points of 1 mm
     assert new["success"] == ref["success"]
-    # the point is defined to the Gauss-Newton tolerance (1e-8 mm in scaled units) and what is computed there
-    # moves with the condition of the whitened Jacobian; 1e-5 relative covers kappa up to 1e3 at points of 1 mm
-    _close(ref, new, 1e-5, cid)
+    assert _texts_agree(ref["status"], new["status"]), (ref["status"], new["status"])
+    assert _vectors_agree(ref["estimate"], new["estimate"], 1e-5)
+    assert new["info"].get("rank") == ref["info"].get("rank")
+    assert new["fit"]["rejected"] == ref["fit"]["rejected"] and new["fit"]["checked"] == ref["fit"]["checked"]
+    if ref["std_kind"] == "total":  # (a zero noise model's covariance is scaled by the round-off residuals)
+        assert _vectors_agree(ref["covariance"], new["covariance"], 1e-5)
 
 
 def test_the_test_is_ipopts_own():
