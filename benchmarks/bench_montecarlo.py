@@ -12,21 +12,26 @@ average printed:
   start-up       the whole command `zerocal compare --trials 2` against `python -c pass` (CPU of the child).
   10,000 trials  `zerocal compare --trials 10000 --workers 2` next to `--workers 1`, whole commands, one pass
                  each, interleaved (--full; otherwise extrapolated from the in-process figures, and labelled so).
+  baseline       (--baseline COMMIT) `zerocal compare --trials --n1 --group 1` of that commit's package (its
+                 zerocal_sym/ extracted by `git archive`, on this environment) against this checkout's, whole
+                 commands interleaved: CPU (the child's) and wall, and their ratio.
   study          the study runner (run_study, as `zerocal study`) on a generated spec (the paper's robot at
                  K = 6, p = 4; the rotary Delta at K = 12, p = 6; one cell each), one worker against two:
                  identifications per CPU second and per wall second; and identify_nlls one at a time.
 
 Usage: python benchmarks/bench_montecarlo.py [--n1 200] [--n2 1000] [--passes 3] [--full] [--study 20000]
-       [--chunk 2000] [--json]
+       [--chunk 2000] [--baseline COMMIT] [--only-baseline] [--json]
 """
 import argparse
 import os
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from _harness import (commands, cpu_all, emit, interleaved, load, load_line, median, ratio, spread, summary)
+from _harness import (commands, cpu_all, cpu_children, emit, interleaved, load, load_line, median, ratio, spread,
+                      summary)
 
 ROOT = Path(__file__).resolve().parents[1]
 ZEROCAL = [sys.executable, "-m", "zerocal_sym"]
@@ -107,6 +112,29 @@ def single_column(label, robot_path, n=200):
     return col
 
 
+def baseline(commit, trials, passes):
+    """`zerocal compare` of ``commit``'s package against this checkout's, whole commands interleaved."""
+    with tempfile.TemporaryDirectory(prefix="bench-mc-") as tmp:
+        arc = subprocess.run(["git", "-C", str(ROOT), "archive", commit, "zerocal_sym"], capture_output=True)
+        if arc.returncode != 0:
+            raise SystemExit(f"git archive {commit}: {arc.stderr.decode().strip()}")
+        subprocess.run(["tar", "-x", "-C", tmp], input=arc.stdout, check=True)
+        argv = ZEROCAL + ["compare", "--trials", str(trials), "--group", "1", "--quiet"]
+
+        def col(pythonpath):
+            env = dict(os.environ, PYTHONPATH=pythonpath) if pythonpath else dict(os.environ)
+
+            def run():
+                subprocess.run(argv, check=True, capture_output=True, env=env, cwd=ROOT if not pythonpath else tmp)
+                return trials
+            return run
+
+        t = interleaved({f"baseline {commit}": col(tmp), "current": col(None)}, passes, clock=cpu_children)
+    return {"commit": commit, "trials": trials, "columns": summary(t),
+            "cpu_ratio_baseline_over_current": ratio(t, f"baseline {commit}", "current"),
+            "cpu_ratio_spread": spread(t, f"baseline {commit}", "current")}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n1", type=int, default=200, help="trials of the one-worker compare (default 200)")
@@ -116,6 +144,9 @@ def main():
                     help="run `zerocal compare --trials 10000` with --workers 2 and --workers 1 (minutes)")
     ap.add_argument("--study", type=int, default=20000, help="trials of each study cell (default 20000)")
     ap.add_argument("--chunk", type=int, default=2000, help="trials per study chunk (default 2000)")
+    ap.add_argument("--baseline", metavar="COMMIT", default=None,
+                    help="also time `zerocal compare` of COMMIT's package against this checkout's (interleaved)")
+    ap.add_argument("--only-baseline", action="store_true", help="only the --baseline comparison")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     args = ap.parse_args()
 
@@ -123,6 +154,15 @@ def main():
     # (cached afterwards), so no build runs inside a timing; ZEROCAL_COMPILE=never measures the interpreted tier
     os.environ.setdefault("ZEROCAL_COMPILE", "always")
     res = {"load_before": load(), "compile_mode": os.environ["ZEROCAL_COMPILE"], "passes": args.passes}
+    if args.baseline:
+        res["baseline"] = b = baseline(args.baseline, args.n1, args.passes)
+        if args.only_baseline:
+            res["load_after"] = load()
+            if emit(res, args.json):
+                return
+            print_baseline(b)
+            print(load_line(res["load_before"], res["load_after"]))
+            return
     reps = {}
     t = interleaved({"1 worker": compare_column(args.n1, 1, out=reps), "2 workers": compare_column(args.n2, 2)},
                     args.passes, clock=cpu_all)
@@ -201,7 +241,18 @@ def main():
               f"wall second, speed-up {r['wall_speedup_2w']:.2f} x; CPU {r['cpu_ratio_2w_to_1w']:.2f} x one "
               f"worker's); identify_nlls one at a time {r['single_per_cpu_s']:.0f} per CPU second (batch "
               f"{r['batch_over_single_cpu']:.1f} x)")
+    if "baseline" in res:
+        print_baseline(res["baseline"])
     print(load_line(res["load_before"], res["load_after"]))
+
+
+def print_baseline(b):
+    cols = b["columns"]
+    lo, hi = b["cpu_ratio_spread"]
+    print(f"`zerocal compare --trials {b['trials']} --group 1`, whole commands interleaved: "
+          + ", ".join(f"{n} {c['cpu_ms']:.2f} ms CPU per trial ({c['wall_ms']:.1f} ms wall)" for n, c in cols.items())
+          + f"; the baseline's CPU / this checkout's {b['cpu_ratio_baseline_over_current']:.2f} x (passes {lo:.2f}-{hi:.2f}; "
+          "start-up included)")
 
 
 if __name__ == "__main__":
