@@ -104,30 +104,9 @@ def _identity_report(values, which):
     return np.asarray(values, float)
 
 
-#: run the Ipopt loops of a chunk in lockstep (:class:`_NllsRounds`); False: one loop after the other, each
-#: identification by ``identify_nlls`` (the same numbers, bit for bit: tests/test_compare_reference.py)
+#: run the Ipopt loops of a chunk in lockstep (:class:`~zerocal_sym.identify.nlls_rounds.LoopRounds`); False: one
+#: loop after the other, each identification by ``identify_nlls`` (the same numbers: tests/test_compare_reference.py)
 NLLS_LOCKSTEP = True
-
-
-class _NllsRounds:
-    """``identify_many`` of :func:`calibration_loops` for the Ipopt loops: each round as ``make_nlls_identifier``'s
-    identifier of its loop would identify it (the sequential MAP's prior from that loop's previous result), all
-    of them at once (:func:`~zerocal_sym.identify.nlls_rounds.identify_rounds`)."""
-
-    def __init__(self, names, noise, sequential):
-        self.names, self.noise, self.sequential = names, noise, sequential
-        self.last = {}
-
-    def __call__(self, robot, rounds, priors, loops):
-        from zerocal_sym.identify.nlls import sequential_prior_cov
-        from zerocal_sym.identify.nlls_rounds import identify_rounds
-
-        covs = [sequential_prior_cov(robot, self.names, self.last.get(i), pr) if self.sequential else None
-                for i, pr in zip(loops, priors)]
-        out = identify_rounds(robot, rounds, priors, self.names, self.noise, covs)
-        for i, res in zip(loops, out):
-            self.last[i] = None if isinstance(res, BaseException) else res
-        return out
 
 
 @dataclass
@@ -176,6 +155,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
     """
     from zerocal_sym.identify.batch import identify_batch
     from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
+    from zerocal_sym.identify.nlls_rounds import LoopRounds
     from zerocal_sym.identify.tsvd import identify_tsvd_many
 
     robot, methods, names, noise = task.robot, task.methods, task.names, task.noise
@@ -221,7 +201,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
         if m not in methods:
             continue
         if NLLS_LOCKSTEP:  # the chunk's Ipopt loops in lockstep, each round's identifications in one mapped call
-            runs = calibration_loops(robot, plant, task.poses, _NllsRounds(names, noise, m == "nlls-seq"),
+            runs = calibration_loops(robot, plant, task.poses, LoopRounds(names, noise, m == "nlls-seq"),
                                      [_continued(ss, st) for ss, _, st in trials], firsts=[m1 for _, m1, _ in trials],
                                      catch=(IdentificationError, ZerocalError), pass_loops=True, **loop_kw)
             for loop, n_id, t_id in runs:

@@ -177,3 +177,24 @@ def identify_rounds(robot, rounds, priors, params, noise, prior_covs=None, alpha
                               l=l, b=b, r=r, rp=rp, J=J, pred=pred, confirmation="first-order test")
         out[i] = _lean(robot, names, scale, noise, np.asarray(priors[i], float), ws[i], sol, K, alpha)
     return out
+
+
+class LoopRounds:
+    """``identify_many`` of :func:`~zerocal_sym.identify.loop.calibration_loops` (``pass_loops=True``) for Ipopt
+    loops: each round as ``make_nlls_identifier(params, noise, sequential)``'s identifier of its loop would
+    identify it (the sequential MAP's prior from that loop's previous result), all of them at once
+    (:func:`identify_rounds`)."""
+
+    def __init__(self, names, noise, sequential: bool):
+        self.names, self.noise, self.sequential = names, noise, sequential
+        self.last = {}
+
+    def __call__(self, robot, rounds, priors, loops):
+        from zerocal_sym.identify.nlls import sequential_prior_cov
+
+        covs = [sequential_prior_cov(robot, self.names, self.last.get(i), pr) if self.sequential else None
+                for i, pr in zip(loops, priors)]
+        out = identify_rounds(robot, rounds, priors, self.names, self.noise, covs)
+        for i, res in zip(loops, out):
+            self.last[i] = None if isinstance(res, BaseException) else res
+        return out
