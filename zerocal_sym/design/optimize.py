@@ -42,7 +42,7 @@ from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import MAX_K_EXACT, DesignError, _check_k
 from zerocal_sym.design.shapes import BoxRegion, CylinderRegion, Region, workspace_region
 from zerocal_sym.design.constraints import Constraints, check_design, make_constraints
-from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective, evaluate
+from zerocal_sym.design.criteria import CHECKED, DESIGN_CRITERIA, _check_criterion, _noise_terms, _objective, evaluate
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
@@ -210,6 +210,8 @@ class DesignResult:
     #: the baseline's poses in internal units (mm, rad), shape (K, n), or None (``paper["poses"]`` is in file
     #: units)
     baseline_poses: np.ndarray | None = None
+    #: the checked design's trade-off (:func:`zerocal_sym.design.checked.checked_design`), or None
+    checked: dict | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
@@ -251,6 +253,8 @@ class DesignResult:
             "continuous": {k: v for k, v in self.continuous.items() if k in ("value", "runs", "time_s", "build_s")},
             "timing_s": self.timing,
         })
+        if self.checked is not None:
+            rep["checked"] = self.checked
         return rep
 
 
@@ -298,7 +302,7 @@ def _certificate(ad, criterion, value, K, design_value_crlb=None):
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
                     exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None,
-                    method: str = "auto", certificate: bool = True) -> DesignResult:
+                    method: str = "auto", certificate: bool = True, requirement=None) -> DesignResult:
     """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
     Two paths (``method``):
@@ -327,7 +331,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     robot : Robot
     K : int
         Number of poses (>= p + 1: 5 for the planar robot, 7 for the Delta).
-    criterion : {"cond", "D", "A", "E", "crlb", "position", "mse"}
+    criterion : {"cond", "D", "A", "E", "crlb", "position", "mse", "checked"}
+        ``checked``: the crlb among designs whose fit check sees what they assume
+        (:func:`zerocal_sym.design.checked.checked_design`).
     cons : Constraints, optional
         Default :func:`make_constraints` (workspace, l0 = 350 mm range,
         the robot's margin, no joint limits).
@@ -343,6 +349,8 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         default :func:`zerocal_sym.identify.bias.default_tolerances`).
     method : {"auto", "exact", "approx"}
     certificate : bool
+    requirement : zerocal_sym.design.detection.Requirement, optional
+        What a ``checked`` design must see (default: its defaults with ``tolerances``).
 
     Returns
     -------
@@ -353,7 +361,12 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     from zerocal_sym.design.rounding import realize
 
     _check_k(K, robot)
-    _check_criterion(criterion)
+    _check_criterion(criterion, DESIGN_CRITERIA)
+    if criterion == CHECKED:
+        from zerocal_sym.design.checked import checked_design
+
+        return checked_design(robot, K, cons or make_constraints(robot), NoiseModel.coerce(noise, robot=robot),
+                              seed, n_starts, exchange_starts, grid, tolerances, method, certificate, requirement)
     if method not in METHODS:
         raise DesignError(f"unknown design method {method!r} (known: {', '.join(METHODS)})")
     if method == "auto":
@@ -418,12 +431,12 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         if not polished:
             raise DesignError("neither method produced a design that meets the constraints")
         label, P, _ = min(polished, key=lambda c: c[2])
-    report = evaluate(robot, P, criterion, noise, cons, tolerances)
+    report = evaluate(robot, P, criterion, noise, cons, tolerances, requirement)
     timing["total"] = time.perf_counter() - t0
     cert = None
     if ad is not None:
         cert = _certificate(ad, criterion, report["criterion"]["value"], K, report["criterion"]["values"]["crlb"])
-    paper = None if base is None else evaluate(robot, base, criterion, noise, cons, tolerances)
+    paper = None if base is None else evaluate(robot, base, criterion, noise, cons, tolerances, requirement)
     return DesignResult(poses=P, criterion=criterion, report=report, paper=paper, constraints=cons, exchange=ex,
                         continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme,
                         baseline_note=base_note, baseline_rejected=rejected, baseline_label=base_label,
