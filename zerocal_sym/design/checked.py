@@ -245,15 +245,12 @@ def checked_design(robot, K, cons, noise, seed, n_starts, exchange_starts, grid,
     info["cost"] = report["criterion"]["value"] / ref_crlb if ref_crlb else None
     ref.timing["total"] = ref.timing.get("total", 0.0) + time.perf_counter() - t0
     cert = ref.certificate
-    if cert is not None and cert.get("criterion") == "crlb":
-        cert = dict(cert, design_value=report["criterion"]["value"],
-                    efficiency_lower_bound=_efficiency(cert, report["criterion"]["value"]))
+    if ref.approx_design is not None:
+        from zerocal_sym.design.optimize import _certificate
+
+        v = report["criterion"]["value"]
+        cert = _certificate(ref.approx_design, "crlb", v, K, v, robot, P)
     ref.poses, ref.criterion, ref.report, ref.method, ref.certificate = P, CHECKED, report, label, cert
     ref.checked = info
     return ref
 
-
-def _efficiency(cert, value):
-    """The crlb certificate's efficiency lower bound of a design of crlb ``value``."""
-    b = cert.get("bound")
-    return (b / value) ** 2 if b is not None and value else None

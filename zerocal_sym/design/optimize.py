@@ -212,6 +212,8 @@ class DesignResult:
     baseline_poses: np.ndarray | None = None
     #: the checked design's trade-off (:func:`zerocal_sym.design.checked.checked_design`), or None
     checked: dict | None = None
+    #: the approximate design behind ``certificate`` (not in the report), or None
+    approx_design: object = field(default=None, repr=False)
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
@@ -279,11 +281,18 @@ def _ratio(a, b):
     return float(r) if math.isfinite(r) else None
 
 
-def _certificate(ad, criterion, value, K, design_value_crlb=None):
-    """The certificate block of a design from an approximate design of the same criterion (or crlb for mse)."""
+def _certificate(ad, criterion, value, K, design_value_crlb=None, robot=None, P=None):
+    """The certificate block of a design from an approximate design of the same criterion (or crlb for mse).
+
+    With the design's poses ``P`` the bound covers them too (:meth:`ApproxDesign.covered`): the efficiency
+    is never one against a candidate set the design lies outside; ``certificate`` says over how many poses.
+    """
     if ad is None:
         return None
-    d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K),
+    if robot is not None and P is not None:
+        ad = ad.covered(robot, P)
+    d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K), "certificate": f"over {ad.n_candidates} candidates",
+         "region_search": ad.info.get("region_search"),
          "measure_efficiency_lower_bound": ad.eff_lb, "n_candidates": ad.n_candidates,
          "rho_window_mm": list(ad.window), "windows": ad.windows, "candidates": ad.info.get("candidates"),
          "model": "order-free pose model (servo variance + sigma_m^2/4 per pose): its optimum bounds every "
@@ -435,11 +444,12 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     timing["total"] = time.perf_counter() - t0
     cert = None
     if ad is not None:
-        cert = _certificate(ad, criterion, report["criterion"]["value"], K, report["criterion"]["values"]["crlb"])
+        cert = _certificate(ad, criterion, report["criterion"]["value"], K, report["criterion"]["values"]["crlb"],
+                            robot, P)
     paper = None if base is None else evaluate(robot, base, criterion, noise, cons, tolerances, requirement)
     return DesignResult(poses=P, criterion=criterion, report=report, paper=paper, constraints=cons, exchange=ex,
                         continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme,
                         baseline_note=base_note, baseline_rejected=rejected, baseline_label=base_label,
                         certificate=cert, approximate=approx_info, tolerances=tolerances,
                         noise_report=dict(noise_dict(robot, noise), description=describe_noise(robot, noise)),
-                        baseline_poses=base)
+                        baseline_poses=base, approx_design=ad)
