@@ -360,8 +360,9 @@ def _print_text(out, res, robot):
     if cert:
         eff = cert.get("efficiency_lower_bound")
         what = cert["criterion"]
-        print(f"certificate: no {out['K']}-pose design on the {cert['n_candidates']} candidate poses has {what} "
-              f"better than {_fmt(cert['bound'])} {units_.get(what, '')}; this design's efficiency >= "
+        print(f"certificate {cert.get('certificate') or ''}: no {out['K']}-pose design on the "
+              f"{cert['n_candidates']} candidate poses (this design's among them) has {what} better than "
+              f"{_fmt(cert['bound'])} {units_.get(what, '')}; this design's efficiency >= "
               f"{_fmt(eff, '.4f')}" + (f" ({cert['note']})" if cert.get("note") else ""))
         if cert.get("candidates"):
             print(f"  (candidates: {cert['candidates']})")
