@@ -75,14 +75,19 @@ def screen(X, r, h, k: int = MAX_STARTS) -> np.ndarray:
     largest bounds first, at most ``k``; ``r`` (N,) is ``d / s`` at ``X`` (N, n), ``h`` the grid spacing."""
     N = len(X)
     hs = np.broadcast_to(np.asarray(h, float), (X.shape[1],))
-    U = X / hs  # in grid spacings
+    order = np.argsort(X[:, 0] / hs[0], kind="stable")
+    U = X[order] / hs  # in grid spacings, sorted by the first coordinate
+    rs = r[order]
     slope = np.zeros(N)
-    for i0 in range(0, N, 512):  # pairwise in blocks: N^2 distances, never N^2 memory at once
-        D = np.linalg.norm(U[i0:i0 + 512, None, :] - U[None, :, :], axis=2)
+    B = 256
+    for i0 in range(0, N, B):  # a block against the points within 1.5 spacings of it in the first coordinate
+        blk = U[i0:i0 + B]
+        j0 = int(np.searchsorted(U[:, 0], blk[0, 0] - 1.5, "left"))
+        j1 = int(np.searchsorted(U[:, 0], blk[-1, 0] + 1.5, "right"))
+        D = np.sqrt(np.sum((blk[:, None, :] - U[None, j0:j1, :]) ** 2, axis=2))
         near = (D > 0) & (D <= 1.5)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sl = np.where(near, np.abs(r[None, :] - r[i0:i0 + 512, None]) / np.where(near, D, 1.0), 0.0)
-        slope[i0:i0 + 512] = sl.max(axis=1)
+        sl = np.abs(rs[None, j0:j1] - rs[i0:i0 + B, None]) / np.where(near, D, 1.0)
+        slope[order[i0:i0 + B]] = np.max(np.where(near, sl, 0.0), axis=1)
     half_diag = 0.5 * math.sqrt(X.shape[1])
     bound = r + 2.0 * slope * half_diag
     cand = np.flatnonzero(bound >= 1.0)

@@ -90,7 +90,8 @@ def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
         whole = np.clip(P[None] + step * U * width, lo, hi)  # (R, K, n)
         X = np.vstack([single, whole.reshape(-1, n)])
         ok = _pointwise_ok(robot, X, cons)
-        Tx = Terms(robot, X, fn.noise)
+        # an infeasible pose's terms may not be finite: the current pose stands in for it (its trial is dropped)
+        Tx = Terms(robot, np.where(ok[:, None], X, np.vstack([P[which], np.tile(P, (POLISH_RANDOM, 1))])), fn.noise)
         ns = len(single)
         # the trial designs: one pose replaced, or all of them
         idx = np.repeat(np.arange(K)[None], ns + POLISH_RANDOM, axis=0)
