@@ -301,6 +301,25 @@ def test_reachable_k6_design_and_baseline(robot, reach450):
     assert design.check_design(robot, np.array(d["paper"]["poses"]), reach450) == []
 
 
+def test_certificate_is_not_above_a_denser_candidate_set(robot, reach450):
+    """The certificate holds beyond its grid: for the K = 6 design of the reachable set (y >= 450 mm), the
+    efficiency it certifies (with the local maxima of the sensitivity over the region) is not above what a
+    grid of four times the candidates alone gives the same design -- up to the search's tolerance.  The grid
+    alone (the certificate before the search) is above it."""
+    from zerocal_sym.design import certify
+
+    res = design.optimize_design(robot, 6, "crlb", reach450, NOISE, seed=0, n_starts=2, exchange_starts=2)
+    v, cert = res.report["crlb_rms_deg"], res.certificate
+    dense = approx.approximate_design(robot, "crlb", reach450, NOISE, n_candidates=6000, search=False)
+    grid = approx.approximate_design(robot, "crlb", reach450, NOISE, search=False)
+    print(f"efficiency >= {cert['efficiency_lower_bound']:.4f} certified; {dense.efficiency(v, 6):.4f} on "
+          f"{dense.n_candidates} grid poses; {grid.efficiency(v, 6):.4f} on the {grid.n_candidates} of the grid alone")
+    assert cert["efficiency_lower_bound"] <= dense.efficiency(v, 6) * (1 + certify.REGION_TOL)
+    assert grid.efficiency(v, 6) > dense.efficiency(v, 6)  # what the search corrects
+    assert cert["certificate"] == f"over {cert['n_candidates']} candidates" and cert["region_search"]["added"] > 0
+    assert "the design's 6 poses" in cert["candidates"]
+
+
 def test_baseline_never_singular_or_infeasible(robot):
     """A region whose edges are singular: the rule on them is rejected, the workspace scheme taken."""
     cons = design.make_constraints(robot, region="reachable", bounds=(-700, 700, 450, 800))

@@ -39,7 +39,7 @@ from zerocal_sym.design.constraints import Constraints, _pointwise_ok, make_cons
 from zerocal_sym.design.criteria import _check_criterion, _criterion_weights, _user_value
 from zerocal_sym.design.fewest import fewest_poses  # noqa: F401 - kept importable from here (benchmarks)
 from zerocal_sym.design.limits import DesignError
-from zerocal_sym.design.certify import search_region
+from zerocal_sym.design.certify import boundary_points, search_region
 from zerocal_sym.design.measure import TOL, e_certificate, solve_measure
 from zerocal_sym.design.posemodel import E_Q, PoseModel, _crit, _schur, _sens, _stats
 from zerocal_sym.design.terms import Weights
@@ -356,12 +356,17 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     cons = cons or make_constraints(robot)
     wts = _criterion_weights(robot, criterion, tolerances) if criterion == "position" else Weights(robot, tolerances)
     X, h = candidate_poses(robot, cons, n_candidates)
+    n_boundary = 0
+    if search:  # the grid's cells closed at the feasible set's boundary
+        B = boundary_points(robot, cons, X, h)
+        X, n_boundary = np.vstack([X, B]), len(B)
     if np.ndim(h):
         k = int(round(float((cons.region.hi[0] - cons.region.lo[0]) / h[0]))) + 1
-        grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X)} feasible poses)"
+        grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X) - n_boundary} feasible poses)"
     else:
-        grid = f"a grid over the region, {h:.3g} mm apart ({len(X)} feasible poses)"
-    candidates = f"{grid} and {refine} round{'s' if refine != 1 else ''} of local refinement around the measure's support"
+        grid = f"a grid over the region, {h:.3g} mm apart ({len(X) - n_boundary} feasible poses)"
+    candidates = (f"{grid}{f', {n_boundary} points on the boundary of the feasible set next to it' if n_boundary else ''}"
+                  f" and {refine} round{'s' if refine != 1 else ''} of local refinement around the measure's support")
     model = PoseModel(robot, X, noise, criterion, wts)
     p = model.aq.shape[1]
     exact, enlarged = _windows(model.rho, cons)

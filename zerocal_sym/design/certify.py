@@ -38,9 +38,13 @@ MAX_STARTS = 32
 #: a maximum is added when ``d > s (1 + tol)``, tol = this
 REGION_TOL = 1e-3
 #: the pattern search's first and last step, in grid spacings
-FIRST_STEP, FINAL_STEP = 0.5, 1e-4
+FIRST_STEP, FINAL_STEP = 0.25, 4e-3
 #: the pattern search's most moves per start
 MAX_MOVES = 200
+#: an infeasible move is halved back towards its start this many times, at most
+BACKTRACK = 3
+#: bisection steps of a boundary point (:func:`boundary_points`): to the grid spacing / 2^6
+BOUNDARY_HALVINGS = 6
 
 
 def directions(n: int) -> np.ndarray:
@@ -54,6 +58,32 @@ def directions(n: int) -> np.ndarray:
                     for sj in (1, -1):
                         dirs.append(((si * E[i] + sj * E[j]) / math.sqrt(2))[None])
     return np.vstack(dirs)
+
+
+def boundary_points(robot, cons, X, h, halvings: int = BOUNDARY_HALVINGS) -> np.ndarray:
+    """Points on the boundary of the feasible set next to the grid ``X`` (N, n) of spacing ``h``, shape (B, n).
+
+    For each candidate and each unit move (:func:`directions`) whose neighbour one spacing away is not
+    feasible, the last feasible point of the segment between them (bisection, ``halvings`` steps: to
+    ``h / 2^halvings``); those more than ``h / 100`` from the candidate.  The grid's cells at the boundary
+    are closed by them: near a singularity margin or the reach the sensitivity can climb steeply within
+    the last cell, where the grid has no point.
+    """
+    n = X.shape[1]
+    hs = np.broadcast_to(np.asarray(h, float), (n,))
+    dirs = directions(n)
+    base = np.repeat(X, len(dirs), axis=0)
+    far = (X[:, None, :] + dirs[None] * hs).reshape(-1, n)
+    out = ~_pointwise_ok(robot, far, cons)
+    if not np.any(out):
+        return np.zeros((0, n))
+    lo, hi = base[out], far[out]  # lo feasible, hi not
+    for _ in range(halvings):
+        mid = 0.5 * (lo + hi)
+        ok = _pointwise_ok(robot, mid, cons)
+        lo[ok], hi[~ok] = mid[ok], mid[~ok]
+    keep = np.linalg.norm((lo - base[out]) / hs, axis=1) > 1e-2
+    return np.unique(np.round(lo[keep], 9), axis=0)
 
 
 class Sensitivity:
@@ -109,8 +139,17 @@ def maximise(robot, cons, sens: Sensitivity, X0, h, window):
     active = np.ones(S, bool)
     while np.any(active):
         a = np.flatnonzero(active)
+        base = np.repeat(X[a], len(dirs), axis=0)
         Y = (X[a, None, :] + step[a, None, None] * dirs[None] * hs).reshape(-1, n)
         ok = _pointwise_ok(robot, Y, cons)
+        # a move that leaves the feasible set goes as far along it as feasible (halving back, BACKTRACK times):
+        # at a curved boundary (the singularity margin, the reach) it slides along it
+        for _ in range(BACKTRACK):
+            bad = np.flatnonzero(~ok)
+            if not len(bad):
+                break
+            Y[bad] = 0.5 * (Y[bad] + base[bad])
+            ok[bad] = _pointwise_ok(robot, Y[bad], cons)
         ry = np.full(len(Y), -np.inf)
         if np.any(ok):
             val, rho = sens(Y[ok])
