@@ -405,7 +405,7 @@ def _print_detection(out, ju):
         return
     base = out.get("baseline", "paper") if pd else ""
     print()
-    print(f"fit check (alpha {d['alpha']:g}): power against{'':14}{'design':>10}{base:>12}")
+    print(f"{'fit check (alpha ' + format(d['alpha'], 'g') + '): power against':48}{'design':>10}{base:>12}")
     print(f"  {'spare degrees of freedom':46}{d['dof']:>10}{(pd or {}).get('dof', ''):>12}")
     scale = next((f"{r['size']:g} %" for r in d["scenarios"] if r["name"] == "scale"), "")
     bad = next((f"{r['size']:g}" for r in d["scenarios"] if r["kind"] == "reading"), "")
@@ -420,9 +420,10 @@ def _print_detection(out, ju):
                                                            else x.get("note", "cannot run"))
         print(f"  {name}: {verdict}")
     inv = d.get("invisible_entries")
-    print(f"  (required: power >= {d['power_target']:g} against every order error; against an entry or a bad reading "
-          f"unless it moves no offset by {d['harm_sigma']:g} sigma" + (f"; no design sees {', '.join(inv)}" if inv
-                                                                        else "") + ")")
+    print(f"  (required: power >= {d['power_target']:g} against every order error, and against the scale error and "
+          f"a bad reading unless it moves no offset by {d['harm_sigma']:g} sigma ({d['harm_counted_in']}); a "
+          "single entry at its tolerance is reported, not required"
+          + (f"; no design sees {', '.join(inv)}" if inv else "") + ")")
     c = out.get("checked")
     if c:
         cd = c["crlb_design"]

@@ -225,6 +225,10 @@ def checked_design(robot, K, cons, noise, seed, n_starts, exchange_starts, grid,
     req = requirement or Requirement(robot, tolerances)
     ref = optimize_design(robot, K, "crlb", cons, noise, seed, n_starts, exchange_starts, grid,
                           tolerances=tolerances, method=method, certificate=certificate, requirement=req)
+    req.count_harm_in(robot, ref.poses, noise, "the crlb-optimal design's")
+    ref.report = evaluate(robot, ref.poses, "crlb", noise, cons, tolerances, req)
+    if ref.baseline_poses is not None:
+        ref.paper = evaluate(robot, ref.baseline_poses, CHECKED, noise, cons, tolerances, req)
     ref_det = ref.report["detection"] or {}
     ref_crlb = ref.report["criterion"]["value"]
     info = {"requirement": req.to_dict(), "crlb_design": {"crlb": ref_crlb, "method": ref.method,

@@ -19,7 +19,8 @@ design's linearisation point):
 
 * **robot-file entries** (the source errors the identification holds at zero) each at its tolerance
   (:func:`zerocal_sym.identify.bias.make_tolerances`: the mechanism's defaults, or the robot file's,
-  and ``--tolerance``): ``delta = D a_o t_j``;
+  and ``--tolerance``): ``delta = D a_o t_j``; and **every length of the robot file** off by the same
+  fraction (:func:`scale_column`, a file for another robot of the family, or in other units);
 * **the poses visited in reverse order**, and **two consecutive poses swapped** (each pair): the
   readings of the visited order against the file's, ``delta = D rho(pi) - D rho``;
 * **one bad reading** of a stated size ``b`` (mm) at each reading in turn: ``delta = b e_k``.
@@ -29,11 +30,7 @@ exact model (:func:`detection`: the exact Gauss-Newton fit of the noise-free rea
 order, :meth:`zerocal_sym.identify.exact_refits._Exact.chi2_fit`, as the fit check's diagnosis refits
 them), and the smaller of the two is reported.
 
-**The requirement** of a checked design (:data:`DEFAULT_POWER`, :data:`DEFAULT_HARM_SIGMA`): at least
-one spare degree of freedom, and for every scenario either power >= 0.9, or, for a robot-file entry or
-a bad reading, harm below one standard deviation (an error the check cannot see is harmless then).  A
-wrong visiting order must be seen whatever it does: at zero offsets a mirror-symmetric design's reversed
-readings are its own (harm 0), but at the robot's offsets the fit answers with the offsets mirrored.
+What a checked design must see is :mod:`zerocal_sym.design.detection`'s (its :class:`Requirement`).
 """
 from __future__ import annotations
 
@@ -213,7 +210,7 @@ def _covariance_batch(v, sm2):
     return C
 
 
-def noncentralities(aq, v, sm2, delta, offsets):
+def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
     """Non-centrality and harm of each scenario for B designs (first order).
 
     Parameters
@@ -228,13 +225,16 @@ def noncentralities(aq, v, sm2, delta, offsets):
         :func:`scenario_effects`.
     offsets : list of int
         Columns of ``aq`` that are zero offsets.
+    sigma : ndarray, shape (m,), optional
+        The standard deviations the harm is counted in (the columns' units); default each design's own.
 
     Returns
     -------
     lam : ndarray, shape (B, S)
         ``|(I - H) L^-1 delta|^2``; inf where the design cannot identify the parameters.
     harm : ndarray, shape (B, S)
-        The largest ``|b_i| / sigma_i`` over the zero offsets (``b`` the fit's shift, ``sigma`` its CRLB).
+        The largest ``|b_i| / sigma_i`` over the zero offsets (``b`` the fit's shift, ``sigma`` its CRLB, or the
+        ``sigma`` given).
     """
     A = np.diff(aq, axis=1)
     L = np.linalg.cholesky(_covariance_batch(v, sm2))
@@ -251,7 +251,8 @@ def noncentralities(aq, v, sm2, delta, offsets):
     if np.any(ok):
         Rinv = np.linalg.inv(R[ok])
         b = np.einsum("bpq,bqs->bps", Rinv, QtD[ok])[:, offsets]
-        sig = np.sqrt(np.sum(Rinv ** 2, axis=2))[:, offsets]  # sqrt(diag((R^T R)^-1))
+        sig = np.sqrt(np.sum(Rinv ** 2, axis=2))[:, offsets] if sigma is None else \
+            np.broadcast_to(np.asarray(sigma, float), (len(Rinv), len(offsets)))  # sqrt(diag((R^T R)^-1))
         harm[ok] = np.max(np.abs(b) / sig[:, :, None], axis=1)
     return lam, harm
 
