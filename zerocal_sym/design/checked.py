@@ -19,7 +19,7 @@ import numpy as np
 
 from zerocal_sym.design.constraints import Constraints, _pointwise_ok, check_design
 from zerocal_sym.design.criteria import _noise_terms
-from zerocal_sym.design.detection import Requirement, Terms, evaluate_batch
+from zerocal_sym.design.detection import ORDER_MARGIN, PENALTY, Requirement, Terms, detection, evaluate_batch
 from zerocal_sym.design.terms import _crlb_weights, offset_positions
 
 #: compass search: the first step as a fraction of the region's width per coordinate, and the last
@@ -28,13 +28,16 @@ POLISH_FIRST, POLISH_LAST = 1.0 / 16, 1e-5
 POLISH_MAX_MOVES = 400
 #: compass search: moves of all the poses at once per round
 POLISH_RANDOM = 32
+#: starts of the pattern search from the crlb design shaken: how many, and by how much (a fraction of the
+#: region's width per coordinate, normal)
+PERTURBED, PERTURB = 3, 0.03
 
 
 class Objective:
     """The penalised objective of designs drawn from a set of poses: ``Objective(...)(P)(idx)``."""
 
-    def __init__(self, robot, noise, req: Requirement):
-        self.robot, self.noise, self.req = robot, noise, req
+    def __init__(self, robot, noise, req: Requirement, penalty: float = PENALTY):
+        self.robot, self.noise, self.req, self.penalty = robot, noise, req, penalty
         self.sm2 = _noise_terms(noise, robot)[0]
         self.off = offset_positions(robot)
         self.w = _crlb_weights(robot)
@@ -45,7 +48,7 @@ class Objective:
 
     def of_terms(self, d):
         """``(objective, crlb objective, shortfall)`` of B designs from :meth:`Terms.take` (B, K, ...)."""
-        o, oc, short, _, _ = evaluate_batch(self.robot, self.req, d, self.sm2, self.off, self.w)
+        o, oc, short, _, _ = evaluate_batch(self.robot, self.req, d, self.sm2, self.off, self.w, self.penalty)
         return o, oc, short
 
 
@@ -169,6 +172,7 @@ def checked_search(robot, K, cons: Constraints, noise, req: Requirement, starts,
     from zerocal_sym.design.exchange import candidate_grid, exchange_design
     from zerocal_sym.design.order import best_order
 
+    margin, req.order_margin = req.order_margin, ORDER_MARGIN
     fn = Objective(robot, noise, req)
     cand = candidate_grid(robot, cons, *(grid or cons.region.default_grid))
     if len(cand) > 1:
@@ -176,27 +180,46 @@ def checked_search(robot, K, cons: Constraints, noise, req: Requirement, starts,
     ex = exchange_design(robot, K, "crlb", cons, noise, seed, exchange_starts, grid, objective=fn)
     tried = []
     best = None
-    for label, P0 in [("exchange", ex["poses"])] + list(starts):
+    starts = [("exchange", ex["poses"])] + [(lab, P) for lab, P in starts if P is not None]
+    rng = np.random.default_rng(seed)
+    lo, hi = _region_box(cons, starts[0][1])
+    for j in range(PERTURBED):  # the crlb design shaken (its symmetry is what the requirement breaks)
+        P = np.clip(starts[1][1] + rng.normal(scale=PERTURB, size=starts[1][1].shape) * (hi - lo), lo, hi)
+        ok = _pointwise_ok(robot, P, cons)
+        P[~ok] = starts[1][1][~ok]
+        starts.append((f"{starts[1][0]} shaken ({j + 1})", P))
+    for label, P0 in starts:
         if P0 is None or check_design(robot, P0, cons):
             continue
         order, _ = best_order(robot, P0, "crlb", noise, cons, objective=fn)
         P1 = np.asarray(P0, float)[order]
         lab = label + (" +order" if np.any(order != np.arange(K)) else "")
-        P2, o2 = polish(robot, P1, cons, fn)
+        P2, o2 = polish(robot, P1, cons, fn, seed)
         if check_design(robot, P2, cons):
             P2, o2 = P1, fn(P1)(np.arange(K)[None])[0]
         else:
             lab += " +compass"
         _, oc, short = fn.of_terms(Terms(robot, P2, noise).take(np.arange(K)[None]))
         tried.append({"label": lab, "objective": float(o2), "crlb_objective": float(oc[0]),
-                      "shortfall": float(short[0])})
-        if best is None or o2 < best[2]:
-            best = (lab, P2, o2)
-    if best is None:
+                      "shortfall": float(short[0]), "poses": P2})
+    req.order_margin = margin
+    if not tried:
         from zerocal_sym.design.limits import DesignError
 
         raise DesignError("no checked design meets the constraints")
-    return best[1], {"label": best[0], "tried": tried, "exchange": ex}
+    # the best end whose report (the orders refitted on the exact model) meets the requirement, else the best
+    tried.sort(key=lambda t: t["objective"])
+    best = tried[0]
+    for t in tried:
+        if t["shortfall"] == 0.0:
+            t["meets"] = bool(detection(robot, t["poses"], noise, req)["meets"])
+            if t["meets"]:
+                best = t
+                break
+    for t in tried:
+        t.pop("poses") if t is not best else None
+    P = best.pop("poses")
+    return P, {"label": best["label"], "tried": tried, "exchange": ex}
 
 
 def checked_design(robot, K, cons, noise, seed, n_starts, exchange_starts, grid, tolerances, method, certificate,

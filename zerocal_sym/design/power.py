@@ -191,23 +191,33 @@ def scenario_effects(ao, gs, rho, tol, scale_error: float, bad_reading_mm: float
     """
     B, K, _ = ao.shape
     ent = np.diff(ao, axis=1) * tol
-    dr = np.diff(rho, axis=1)
-    orders = [np.diff(rho[:, pi], axis=1) - dr for _, _, pi in order_permutations(K)]
+    perms = np.array([pi for _, _, pi in order_permutations(K)])  # (S_o, K)
+    orders = np.diff(rho[:, perms.T], axis=1) - np.diff(rho, axis=1)[:, :, None]  # (B, K-1, S_o)
     bad = np.broadcast_to(bad_reading_mm * np.eye(K - 1), (B, K - 1, K - 1))
-    return np.concatenate([ent, scale_error * np.diff(gs, axis=1)[:, :, None], np.stack(orders, axis=2), bad],
-                          axis=2)
+    return np.concatenate([ent, scale_error * np.diff(gs, axis=1)[:, :, None], orders, bad], axis=2)
 
 
-def _covariance_batch(v, sm2):
-    """The readings' covariance ``sigma_m^2 I + D diag(v) D^T`` of B designs, shape (B, K-1, K-1)."""
+def _whiten_batch(v, sm2, *Ys):
+    """``L^-1 Y`` for each ``Y`` (B, K-1, c), ``L`` the lower-bidiagonal Cholesky factor of the readings'
+    covariance ``sigma_m^2 I + D diag(v) D^T`` (tridiagonal: diagonal ``sm2 + v_k + v_{k+1}``, off-diagonal
+    ``-v_{k+1}``) of each of B designs; forward substitution, O(K) steps over the batch."""
     B, K = v.shape
-    C = np.zeros((B, K - 1, K - 1))
-    i = np.arange(K - 1)
-    C[:, i, i] = sm2 + v[:, :-1] + v[:, 1:]
-    j = np.arange(K - 2)
-    C[:, j, j + 1] = -v[:, 1:-1]
-    C[:, j + 1, j] = -v[:, 1:-1]
-    return C
+    diag = sm2 + v[:, :-1] + v[:, 1:]
+    off = -v[:, 1:-1]
+    ell = np.empty((B, K - 1))
+    sub = np.empty((B, max(K - 2, 0)))
+    ell[:, 0] = np.sqrt(diag[:, 0])
+    for k in range(K - 2):
+        sub[:, k] = off[:, k] / ell[:, k]
+        ell[:, k + 1] = np.sqrt(diag[:, k + 1] - sub[:, k] ** 2)
+    out = []
+    for Y in Ys:
+        W = np.empty(Y.shape)
+        W[:, 0] = Y[:, 0] / ell[:, 0, None]
+        for k in range(1, K - 1):
+            W[:, k] = (Y[:, k] - sub[:, k - 1, None] * W[:, k - 1]) / ell[:, k, None]
+        out.append(W)
+    return out
 
 
 def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
@@ -235,26 +245,26 @@ def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
     harm : ndarray, shape (B, S)
         The largest ``|b_i| / sigma_i`` over the zero offsets (``b`` the fit's shift, ``sigma`` its CRLB, or the
         ``sigma`` given).
+    var : ndarray, shape (B, p)
+        The diagonal of ``F^-1`` (the CRLB squared, the columns' units), inf where singular.
     """
-    A = np.diff(aq, axis=1)
-    L = np.linalg.cholesky(_covariance_batch(v, sm2))
-    Aw = np.linalg.solve(L, A)
-    Dw = np.linalg.solve(L, delta)
+    Aw, Dw = _whiten_batch(v, sm2, np.diff(aq, axis=1), delta)
     Q, R = np.linalg.qr(Aw)
-    QtD = np.einsum("bkp,bks->bps", Q, Dw)
-    res = Dw - np.einsum("bkp,bps->bks", Q, QtD)
-    lam = np.sum(res ** 2, axis=1)
+    QtD = np.matmul(np.swapaxes(Q, 1, 2), Dw)
+    lam = np.sum((Dw - np.matmul(Q, QtD)) ** 2, axis=1)
     d = np.abs(np.diagonal(R, axis1=1, axis2=2))
     ok = d.min(axis=1) > 1e-12 * np.maximum(d.max(axis=1), 1e-300)
     lam[~ok] = np.inf
     harm = np.full(lam.shape, np.inf)
+    var = np.full(aq.shape[::2], np.inf)
     if np.any(ok):
         Rinv = np.linalg.inv(R[ok])
-        b = np.einsum("bpq,bqs->bps", Rinv, QtD[ok])[:, offsets]
-        sig = np.sqrt(np.sum(Rinv ** 2, axis=2))[:, offsets] if sigma is None else \
-            np.broadcast_to(np.asarray(sigma, float), (len(Rinv), len(offsets)))  # sqrt(diag((R^T R)^-1))
+        var[ok] = np.sum(Rinv ** 2, axis=2)  # diag((R^T R)^-1) = diag(F^-1)
+        b = np.matmul(Rinv, QtD[ok])[:, offsets]
+        sig = np.sqrt(var[ok][:, offsets]) if sigma is None else \
+            np.broadcast_to(np.asarray(sigma, float), (len(Rinv), len(offsets)))
         harm[ok] = np.max(np.abs(b) / sig[:, :, None], axis=1)
-    return lam, harm
+    return lam, harm, var
 
 
 def invisible_entries(robot, ao, aq, rtol: float = 1e-8) -> list:
