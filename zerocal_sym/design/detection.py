@@ -44,6 +44,8 @@ SHORTFALL_CAP = 50.0
 #: order scenarios whose first-order non-centrality is below this multiple of the required one are refitted on
 #: the exact model (:func:`detection`)
 EXACT_REFIT_BELOW = 1e3
+#: at most this many order scenarios are refitted exactly per report (the least visible)
+MAX_EXACT_REFITS = 8
 #: the checked search asks an order error's first-order non-centrality for this multiple of the required one:
 #: a swap the fit absorbs by moving the offsets far is absorbed further by the exact model (on the paper's
 #: robot a swap of first-order 21 left 7.3 to the exact refit)
@@ -88,6 +90,16 @@ class Requirement:
         self.tolerances = bias.make_tolerances(robot) if tolerances is None else tolerances
         self.tol = bias.tolerance_vector(robot, self.tolerances, omitted_params(robot))
         self.invisible = ()
+        #: the zero offsets' range an order error's harm is judged over (q-units): what the fit check's
+        #: plausibility accepts (:data:`zerocal_sym.identify.fitcheck.DEFAULT_MAX_OFFSET`, 10 deg or 10 mm)
+        from zerocal_sym.design.terms import _qscale, offset_positions
+        from zerocal_sym.identify.fitcheck import DEFAULT_MAX_OFFSET
+        from zerocal_sym.model import units
+
+        unit = robot.errors.offset_user_unit
+        self.offset_range = DEFAULT_MAX_OFFSET[unit]
+        self.offset_range_q = (float(units.from_user(self.offset_range, robot.errors.offset_unit))
+                               / _qscale(robot)[offset_positions(robot)])
         #: the search asks this many times the required non-centrality of an order error's first order
         #: (:data:`ORDER_MARGIN`); the report judges the exact refit's (1)
         self.order_margin = 1.0
@@ -126,8 +138,12 @@ class Requirement:
         single entries are reported, not required: module docstring), bool shape (S,)."""
         return np.array([k != "entry" or n == "scale" for n, k, _ in pw.scenario_names(self.robot, K)])
 
-    def terms_short(self, lam, harm, trivial, K: int, p: int):
-        """Each scenario's shortfall, shape (B, S): 0 where the rule holds (or is not required)."""
+    def terms_short(self, lam, harm, K: int, p: int):
+        """Each scenario's shortfall, shape (B, S): 0 where the rule holds (or is not required).
+
+        ``log(lambda_req / lambda)`` (an order's with :attr:`order_margin`), ended where the error is
+        harmless: ``min(that, log(harm / harm_sigma))``, at least 0, at most :data:`SHORTFALL_CAP`.
+        """
         dof = K - 1 - p
         if dof <= 0:
             return np.full(lam.shape, SHORTFALL_CAP)
@@ -136,12 +152,10 @@ class Requirement:
             short = math.log(self.lam_required(dof)) - np.log(np.maximum(lam, 1e-300))
             if self.order_margin != 1.0:  # the first order overstates what the exact fit leaves of an order error
                 short = short + np.where(kinds == "order", math.log(self.order_margin), 0.0)
-            harmful = np.log(np.maximum(harm, 1e-300) / self.harm_sigma)
-        short = np.where(kinds == "order", short, np.minimum(short, harmful))
+            short = np.minimum(short, np.log(np.maximum(harm, 1e-300) / self.harm_sigma))
         short = np.where(np.isnan(short), 0.0, short)
         short = np.clip(short, 0.0, SHORTFALL_CAP)
         short[:, ~self.required(K)] = 0.0
-        short[trivial] = 0.0
         return short
 
     def to_dict(self) -> dict:
@@ -174,29 +188,24 @@ class Terms:
                 "rho": self.rho[idx], "theta": self.theta[idx]}
 
 
-def _trivial(theta):
-    """Order scenarios that leave the commanded joints unchanged (replicates swapped), bool (B, S_order)."""
-    same = np.max(np.abs(np.diff(theta, axis=1)), axis=2) < 1e-12  # (B, K-1): pose j+1 is pose j
-    palindrome = np.max(np.abs(theta - theta[:, ::-1]), axis=(1, 2)) < 1e-12
-    return np.column_stack([palindrome, same])  # the order of pw.order_permutations: reversed, swap0, swap1 ...
-
-
 def evaluate_batch(robot, req: Requirement, d: dict, sm2: float, offsets, crlb_weights, penalty: float = PENALTY):
     """``(objective, crlb objective, shortfall, lam, harm)`` of B designs from :meth:`Terms.take`.
 
     The objective is ``log(sum_j w_j [F_q^-1]_jj) + penalty * shortfall`` (smaller is better; the crlb
-    criterion's internal objective plus the penalty).
+    criterion's internal objective plus the penalty).  An order scenario's harm is the larger of its harm at
+    zero offsets and at offsets within :attr:`Requirement.offset_range_q`
+    (:func:`~zerocal_sym.design.power.noncentralities`' ``order_harm``).
     """
     B, K, p = d["aq"].shape
     delta = pw.scenario_effects(d["ao"], d["gs"], d["rho"], req.tol, req.scale_error, req.bad_reading_mm)
-    lam, harm, var = pw.noncentralities(d["aq"], d["v"], sm2, delta, offsets, req.sigma_q)
+    lam, harm, var, order_harm = pw.noncentralities(d["aq"], d["v"], sm2, delta, offsets, req.sigma_q,
+                                                    req.offset_range_q)
     with np.errstate(invalid="ignore", divide="ignore"):
         o = np.log(var @ crlb_weights)  # the crlb criterion's objective (criteria._objective_fisher)
     o[~np.isfinite(o)] = np.inf
-    trivial = np.zeros(lam.shape, bool)
     kinds = np.array([k for _, k, _ in pw.scenario_names(robot, K)])
-    trivial[:, kinds == "order"] = _trivial(d["theta"])
-    short = req.terms_short(lam, harm, trivial, K, p).sum(axis=1)
+    harm[:, kinds == "order"] = np.maximum(harm[:, kinds == "order"], order_harm)
+    short = req.terms_short(lam, harm, K, p).sum(axis=1)
     return o + penalty * short, o, short, lam, harm
 
 
@@ -235,7 +244,7 @@ def detection(robot, P, noise=None, requirement: Requirement | None = None, tole
     if not req.invisible:
         req.find_invisible(Terms(robot, np.asarray(robot.workspace_grid(), float), noise))
     P = np.atleast_2d(np.asarray(P, float))
-    K, p = len(P), len(offset_positions(robot)) + 0
+    K = len(P)
     T = Terms(robot, P, noise)
     p = T.aq.shape[1]
     dof = K - 1 - p
@@ -245,13 +254,12 @@ def detection(robot, P, noise=None, requirement: Requirement | None = None, tole
     lam, harm = lam[0], harm[0]
     names = pw.scenario_names(robot, K)
     kinds = np.array([k for _, k, _ in names])
-    trivial = np.zeros(len(names), bool)
-    trivial[kinds == "order"] = _trivial(T.theta[None])[0]
+    harmless = harm < req.harm_sigma
     lam_req = req.lam_required(dof) if dof > 0 else math.inf
-    exact = _exact_orders(robot, T, noise, lam, kinds, trivial, lam_req)
+    exact = _exact_orders(robot, T, noise, lam, kinds, harmless, lam_req)
     lam = np.where(np.isfinite(exact), np.minimum(lam, exact), lam)
-    short = req.terms_short(lam[None], harm[None], trivial[None], K, p)[0]
-    required = req.required(K) & ~trivial
+    short = req.terms_short(lam[None], harm[None], K, p)[0]
+    required = req.required(K)
     x = pw.chi2_isf(req.alpha, dof) if dof > 0 else math.inf
     rows = []
     for j, (name, kind, what) in enumerate(names):
@@ -293,11 +301,13 @@ def _size(robot, req, name, kind):
     return float(errors.to_user_value(name, req.tolerances.get(name, 0.0))), errors[name].user_unit
 
 
-def _exact_orders(robot, T, noise, lam, kinds, trivial, lam_req):
-    """The exact model's non-centrality of the order scenarios the first order finds below
-    :data:`EXACT_REFIT_BELOW` times ``lam_req`` (inf elsewhere, and where the refit fails)."""
+def _exact_orders(robot, T, noise, lam, kinds, harmless, lam_req):
+    """The exact model's non-centrality of the harmful order scenarios the first order finds below
+    :data:`EXACT_REFIT_BELOW` times ``lam_req``, the :data:`MAX_EXACT_REFITS` least visible of them (inf
+    elsewhere, and where the refit fails)."""
     out = np.full(len(kinds), np.inf)
-    rows = [j for j in np.flatnonzero(kinds == "order") if not trivial[j] and lam[j] < EXACT_REFIT_BELOW * lam_req]
+    rows = [j for j in np.flatnonzero(kinds == "order") if not harmless[j] and lam[j] < EXACT_REFIT_BELOW * lam_req]
+    rows = sorted(rows, key=lambda j: lam[j])[:MAX_EXACT_REFITS]  # the least visible first
     if not rows or not math.isfinite(lam_req):
         return out
     from zerocal_sym.identify.exact_refits import _Exact

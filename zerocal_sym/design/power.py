@@ -220,7 +220,7 @@ def _whiten_batch(v, sm2, *Ys):
     return out
 
 
-def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
+def noncentralities(aq, v, sm2, delta, offsets, sigma=None, offset_range=None):
     """Non-centrality and harm of each scenario for B designs (first order).
 
     Parameters
@@ -237,6 +237,8 @@ def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
         Columns of ``aq`` that are zero offsets.
     sigma : ndarray, shape (m,), optional
         The standard deviations the harm is counted in (the columns' units); default each design's own.
+    offset_range : ndarray, shape (m,), optional
+        The zero offsets' range (the columns' units): with it, ``order_harm``.
 
     Returns
     -------
@@ -247,8 +249,21 @@ def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
         ``sigma`` given).
     var : ndarray, shape (B, p)
         The diagonal of ``F^-1`` (the CRLB squared, the columns' units), inf where singular.
+    order_harm : ndarray, shape (B, S_o), with ``offset_range``
+        How far an order error can move an offset at offsets within their range, to first order in them: at
+        offsets ``t`` the reordered readings' sensitivities ``D a(pi)`` differ from the model's ``D a``, and
+        the fit moves by ``b(0) + G t``, ``G = F^-1 A^T C^-1 (D a(pi) - D a)`` (its offsets' block); the
+        largest ``sum_j |G_ij| range_j / sigma_i`` (a mirror-symmetric design's reversed order:
+        ``G`` = the mirror less the identity; a swap of two replicates: ``G`` = 0).
     """
-    Aw, Dw = _whiten_batch(v, sm2, np.diff(aq, axis=1), delta)
+    K = aq.shape[1]
+    perms = np.array([pi for _, _, pi in order_permutations(K)]) if offset_range is not None else None
+    extra = ()
+    if perms is not None:  # the sensitivities' change of each reordering, only the offsets' columns
+        a_off = aq[:, :, offsets]
+        dA = np.diff(a_off[:, perms.T], axis=1) - np.diff(a_off, axis=1)[:, :, None]  # (B, K-1, S_o, m)
+        extra = (dA.reshape(dA.shape[0], K - 1, -1),)
+    Aw, Dw, *dAw = _whiten_batch(v, sm2, np.diff(aq, axis=1), delta, *extra)
     Q, R = np.linalg.qr(Aw)
     QtD = np.matmul(np.swapaxes(Q, 1, 2), Dw)
     lam = np.sum((Dw - np.matmul(Q, QtD)) ** 2, axis=1)
@@ -257,6 +272,7 @@ def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
     lam[~ok] = np.inf
     harm = np.full(lam.shape, np.inf)
     var = np.full(aq.shape[::2], np.inf)
+    order_harm = None if perms is None else np.full((aq.shape[0], len(perms)), np.inf)
     if np.any(ok):
         Rinv = np.linalg.inv(R[ok])
         var[ok] = np.sum(Rinv ** 2, axis=2)  # diag((R^T R)^-1) = diag(F^-1)
@@ -264,7 +280,14 @@ def noncentralities(aq, v, sm2, delta, offsets, sigma=None):
         sig = np.sqrt(var[ok][:, offsets]) if sigma is None else \
             np.broadcast_to(np.asarray(sigma, float), (len(Rinv), len(offsets)))
         harm[ok] = np.max(np.abs(b) / sig[:, :, None], axis=1)
-    return lam, harm, var
+        if perms is not None:
+            m = len(offsets)
+            G = np.matmul(Rinv, np.matmul(np.swapaxes(Q[ok], 1, 2), dAw[0][ok]))[:, offsets]  # (B', m, S_o m)
+            G = G.reshape(len(Rinv), m, len(perms), m)
+            shift = np.einsum("bisj,j->bsi", np.abs(G), np.asarray(offset_range, float))
+            order_harm[ok] = np.max(shift / sig[:, None, :], axis=2)
+    out = (lam, harm, var)
+    return out + (order_harm,) if perms is not None else out
 
 
 def invisible_entries(robot, ao, aq, rtol: float = 1e-8) -> list:
