@@ -67,7 +67,7 @@ class Requirement:
 
     def __init__(self, robot, tolerances=None, alpha: float = pw.DEFAULT_ALPHA, target: float = pw.DEFAULT_POWER,
                  harm_sigma: float = pw.DEFAULT_HARM_SIGMA, bad_reading_mm: float = pw.DEFAULT_BAD_READING_MM,
-                 scale_error: float = pw.DEFAULT_SCALE_ERROR):
+                 scale_error: float = pw.DEFAULT_SCALE_ERROR, entries: bool = False):
         from zerocal_sym.design.limits import DesignError
         from zerocal_sym.design.terms import omitted_params
         from zerocal_sym.identify import bias
@@ -86,6 +86,8 @@ class Requirement:
         self.robot = robot
         self.alpha, self.target, self.harm_sigma = float(alpha), float(target), float(harm_sigma)
         self.bad_reading_mm, self.scale_error = float(bad_reading_mm), float(scale_error)
+        #: require the single entries too (not the default: module docstring), those some design can see
+        self.entries = bool(entries)
         # the tolerances as every design report resolves them (the mechanism's, the robot file's, the options')
         self.tolerances = bias.make_tolerances(robot) if tolerances is None else tolerances
         self.tol = bias.tolerance_vector(robot, self.tolerances, omitted_params(robot))
@@ -136,7 +138,8 @@ class Requirement:
     def required(self, K: int) -> np.ndarray:
         """Which scenarios the rule covers: the orders, the bad readings and the robot file's scale error (the
         single entries are reported, not required: module docstring), bool shape (S,)."""
-        return np.array([k != "entry" or n == "scale" for n, k, _ in pw.scenario_names(self.robot, K)])
+        return np.array([k != "entry" or n == "scale" or (self.entries and n not in self.invisible)
+                         for n, k, _ in pw.scenario_names(self.robot, K)])
 
     def terms_short(self, lam, harm, K: int, p: int):
         """Each scenario's shortfall, shape (B, S): 0 where the rule holds (or is not required).
@@ -162,7 +165,7 @@ class Requirement:
         return {"alpha": self.alpha, "power": self.target, "harm_sigma": self.harm_sigma,
                 "harm_counted_in": f"{self.sigma_from} standard deviations",
                 "bad_reading_mm": self.bad_reading_mm, "scale_error": self.scale_error,
-                "invisible_entries": list(self.invisible)}
+                "entries_required": self.entries, "invisible_entries": list(self.invisible)}
 
 
 class Terms:
