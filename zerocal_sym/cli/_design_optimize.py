@@ -175,8 +175,9 @@ def requirement_from_args(robot, args, tolerances):
         v = getattr(args, name, None)
         return default if v is None else v
 
-    return Requirement(robot, tolerances, alpha=get("fit_alpha", pw.DEFAULT_ALPHA), target=get("power", pw.DEFAULT_POWER),
-                       bad_reading_mm=get("bad_reading_mm", pw.DEFAULT_BAD_READING_MM))
+    return Requirement(robot, tolerances, alpha=get("fit_alpha", pw.DEFAULT_ALPHA),
+                       target=get("power", pw.DEFAULT_POWER), bad_reading_mm=get("bad_reading_mm",
+                                                                                 pw.DEFAULT_BAD_READING_MM))
 
 
 def _fmt(v, spec=".4g"):

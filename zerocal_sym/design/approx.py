@@ -181,26 +181,13 @@ class ApproxDesign:
         """
         from dataclasses import replace
 
-        from zerocal_sym.design.certify import Sensitivity
+        from zerocal_sym.design.certify import with_poses
 
         P = np.atleast_2d(np.asarray(P, float))
         if not self.bound_windows or not len(P):
             return self
-        mP = PoseModel(robot, P, self.noise, self.criterion, self.weights)
-        out = math.inf
-        for k, (win, Xw, sol) in enumerate(self.bound_windows):
-            inside = np.ones(len(P), bool) if len(self.bound_windows) == 1 else \
-                (mP.rho >= win[0]) & (mP.rho <= win[1])
-            sol = dict(sol)
-            if np.any(inside):
-                if self.criterion == "E":
-                    ext = PoseModel(robot, np.vstack([Xw, P[inside]]), self.noise, "E", self.weights)
-                    sol["eff_lb"], sol["E_bound"] = e_certificate(ext, sol["M"], sol["c"])
-                else:
-                    r = float(np.max(Sensitivity(robot, self.noise, self.criterion, self.weights, sol,
-                                                 mP.W)(P[inside])[0]))
-                    sol["eff_lb"] = 1.0 / max(1.0 / sol["eff_lb"], r)
-            out = min(out, _loss_bound(self.criterion, sol))
+        sols = with_poses(robot, self.criterion, self.noise, self.weights, self.bound_windows, P)
+        out = min(_loss_bound(self.criterion, sol) for sol in sols)
         info = dict(self.info, design_poses=len(P))
         info["candidates"] = str(info.get("candidates", "")).replace(
             ": the bound covers", f", and the design's {len(P)} poses: the bound covers")
@@ -365,8 +352,9 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X) - n_boundary} feasible poses)"
     else:
         grid = f"a grid over the region, {h:.3g} mm apart ({len(X) - n_boundary} feasible poses)"
-    candidates = (f"{grid}{f', {n_boundary} points on the boundary of the feasible set next to it' if n_boundary else ''}"
-                  f" and {refine} round{'s' if refine != 1 else ''} of local refinement around the measure's support")
+    closed = f", {n_boundary} points on the boundary of the feasible set next to it" if n_boundary else ""
+    candidates = (f"{grid}{closed} and {refine} round{'s' if refine != 1 else ''} of local refinement around the "
+                  "measure's support")
     model = PoseModel(robot, X, noise, criterion, wts)
     p = model.aq.shape[1]
     exact, enlarged = _windows(model.rho, cons)
@@ -454,8 +442,8 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         bounds.append((win, idx, sol))
     bound_loss = min(_loss_bound(criterion, b[2]) for b in bounds)
     if search:
-        candidates += (f", and {region['added']} local maxima of the sensitivity over the region (a pattern search from "
-                       f"{region['starts']} starts, the cells a Lipschitz-type screen flags)")
+        candidates += (f", and {region['added']} local maxima of the sensitivity over the region (a pattern search "
+                       f"from {region['starts']} starts, the cells a Lipschitz-type screen flags)")
     candidates += ": the bound covers designs on these candidates, not a proof over every pose of the region"
     sub = model.subset(idx)
     reps, ws = _clusters(sub.X, sol["w"], 1.5 * h / 3 ** refine)

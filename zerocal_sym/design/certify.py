@@ -212,3 +212,26 @@ def search_region(robot, cons, noise, criterion, weights, model, idx, sol, windo
             sol["eff_lb"] = float(sol["s"] / np.max(sol["d"]))
         break
     return model, idx, sol, {"starts": starts, "added": added, "rounds": rounds, "max_ratio": max_ratio}
+
+
+def with_poses(robot, criterion, noise, weights, bound_windows, P) -> list:
+    """Each window's measure (:attr:`~zerocal_sym.design.approx.ApproxDesign.bound_windows`) with its
+    efficiency bound over its candidates *and* the poses of ``P`` (K, n) with ``rho`` in the window (one
+    window: all of them): the largest ``d / s`` of both; E: its certificate over both
+    (:func:`~zerocal_sym.design.measure.e_certificate`).  Returns the measures (dicts), in order."""
+    from zerocal_sym.design.measure import e_certificate
+
+    mP = PoseModel(robot, P, noise, criterion, weights)
+    out = []
+    for win, Xw, sol in bound_windows:
+        inside = np.ones(len(P), bool) if len(bound_windows) == 1 else (mP.rho >= win[0]) & (mP.rho <= win[1])
+        sol = dict(sol)
+        if np.any(inside):
+            if criterion == "E":
+                ext = PoseModel(robot, np.vstack([Xw, P[inside]]), noise, "E", weights)
+                sol["eff_lb"], sol["E_bound"] = e_certificate(ext, sol["M"], sol["c"])
+            else:
+                r = float(np.max(Sensitivity(robot, noise, criterion, weights, sol, mP.W)(P[inside])[0]))
+                sol["eff_lb"] = 1.0 / max(1.0 / sol["eff_lb"], r)
+        out.append(sol)
+    return out

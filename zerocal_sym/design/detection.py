@@ -61,8 +61,8 @@ class Requirement:
     tolerances : dict name -> value (internal units)
     tol : ndarray, shape (r,)
         The tolerances of :func:`zerocal_sym.design.terms.omitted_params`, in their order.
-    invisible : tuple of str
-        Entries no design can see (set by :meth:`find_invisible`; empty until then).
+    invisible : tuple of str or None
+        Entries no design can see (set by :meth:`find_invisible`; None until then).
     """
 
     def __init__(self, robot, tolerances=None, alpha: float = pw.DEFAULT_ALPHA, target: float = pw.DEFAULT_POWER,
@@ -91,7 +91,7 @@ class Requirement:
         # the tolerances as every design report resolves them (the mechanism's, the robot file's, the options')
         self.tolerances = bias.make_tolerances(robot) if tolerances is None else tolerances
         self.tol = bias.tolerance_vector(robot, self.tolerances, omitted_params(robot))
-        self.invisible = ()
+        self.invisible = None  # unknown until :meth:`find_invisible`
         #: the zero offsets' range an order error's harm is judged over (q-units): what the fit check's
         #: plausibility accepts (:data:`zerocal_sym.identify.fitcheck.DEFAULT_MAX_OFFSET`, 10 deg or 10 mm)
         from zerocal_sym.design.terms import _qscale, offset_positions
@@ -138,7 +138,7 @@ class Requirement:
     def required(self, K: int) -> np.ndarray:
         """Which scenarios the rule covers: the orders, the bad readings and the robot file's scale error (the
         single entries are reported, not required: module docstring), bool shape (S,)."""
-        return np.array([k != "entry" or n == "scale" or (self.entries and n not in self.invisible)
+        return np.array([k != "entry" or n == "scale" or (self.entries and n not in (self.invisible or ()))
                          for n, k, _ in pw.scenario_names(self.robot, K)])
 
     def terms_short(self, lam, harm, K: int, p: int):
@@ -165,7 +165,7 @@ class Requirement:
         return {"alpha": self.alpha, "power": self.target, "harm_sigma": self.harm_sigma,
                 "harm_counted_in": f"{self.sigma_from} standard deviations",
                 "bad_reading_mm": self.bad_reading_mm, "scale_error": self.scale_error,
-                "entries_required": self.entries, "invisible_entries": list(self.invisible)}
+                "entries_required": self.entries, "invisible_entries": list(self.invisible or ())}
 
 
 class Terms:
@@ -244,7 +244,7 @@ def detection(robot, P, noise=None, requirement: Requirement | None = None, tole
 
     noise = NoiseModel.coerce(noise, robot=robot)
     req = requirement or Requirement(robot, tolerances)
-    if not req.invisible:
+    if req.invisible is None:
         req.find_invisible(Terms(robot, np.asarray(robot.workspace_grid(), float), noise))
     P = np.atleast_2d(np.asarray(P, float))
     K = len(P)
@@ -281,7 +281,7 @@ def detection(robot, P, noise=None, requirement: Requirement | None = None, tole
            "noncentrality_required": lam_req, "harm_sigma": req.harm_sigma,
            "harm_counted_in": f"{req.sigma_from} standard deviations",
            "power": _smallest(rows, req), "meets": dof > 0 and not unmet, "unmet": unmet,
-           "invisible_entries": list(req.invisible),
+           "invisible_entries": list(req.invisible or ()),
            "scenarios": rows if K <= LIST_ALL_MAX_K else _worst_rows(rows),
            "listed": "all" if K <= LIST_ALL_MAX_K else "the entries, the reversed order, the worst swap and reading",
            "model": "chi2 of the fit check non-central with lambda = |(I - H) L^-1 delta|^2 (first order at zero "
