@@ -123,6 +123,9 @@ def test_design_json_reports_each_designs_detection(capsys):
         assert x["invisible_entries"] == ["e1y", "e2y"]  # the gauge: absorbed by the MAEMM on every design
     assert d["paper"]["detection"]["power"]["reversed"] > 0.999
     assert "reversed" in d["detection"]["unmet"]
+    assert main(["design", "--scheme", "paper", "--json"]) == 0  # the boundary scheme's report too
+    x = json.loads(capsys.readouterr().out)["detection"]
+    assert x["power"] == d["paper"]["detection"]["power"]  # the same six poses as the baseline
 
 
 def test_checked_needs_a_spare_degree_of_freedom(robot, capsys):
