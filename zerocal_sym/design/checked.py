@@ -4,12 +4,13 @@
 :func:`zerocal_sym.design.detection.evaluate_batch` (the crlb criterion's plus
 :data:`~zerocal_sym.design.detection.PENALTY` times the shortfall of the
 :class:`~zerocal_sym.design.detection.Requirement`): the discrete exchange on the penalised objective,
-then, from its best design, from the crlb-optimal design and from the baseline scheme, the best visiting
-order (:func:`zerocal_sym.design.order.best_order`) and a compass search over the poses
-(:func:`polish`: each coordinate of each pose moved by a step, every move feasible, the best taken,
-the step halved when none improves).  Ipopt's polish is not used: its objective is the crlb alone,
-and at the crlb optimum the fit check often sees nothing (a mirror-symmetric design: the reversed order's
-readings are its own).
+then, from its best design, from the crlb-optimal design (and shaken copies of it) and from the baseline
+scheme, the best visiting order (:func:`zerocal_sym.design.order.best_order`) and a pattern search over the
+poses (:func:`polish`: one pose along an axis or a diagonal, or all of them along random directions, only
+feasible moves, the best taken, the step halved when none improves); the winner is the best end whose
+report (:func:`~zerocal_sym.design.detection.detection`, the orders refitted exactly) meets the
+requirement.  Ipopt's polish is not used: its objective is the crlb alone, and at the crlb optimum the fit
+check often sees nothing (a mirror-symmetric design: the reversed order's readings are its own).
 """
 from __future__ import annotations
 
@@ -17,16 +18,17 @@ import math
 
 import numpy as np
 
+from zerocal_sym.design.certify import directions
 from zerocal_sym.design.constraints import Constraints, _pointwise_ok, check_design
 from zerocal_sym.design.criteria import _noise_terms
 from zerocal_sym.design.detection import ORDER_MARGIN, PENALTY, Requirement, Terms, detection, evaluate_batch
 from zerocal_sym.design.terms import _crlb_weights, offset_positions
 
-#: compass search: the first step as a fraction of the region's width per coordinate, and the last
+#: pattern search: the first step as a fraction of the region's width per coordinate, and the last
 POLISH_FIRST, POLISH_LAST = 1.0 / 16, 1e-5
-#: compass search: the most moves
+#: pattern search: the most moves
 POLISH_MAX_MOVES = 400
-#: compass search: moves of all the poses at once per round
+#: pattern search: moves of all the poses at once per round
 POLISH_RANDOM = 32
 #: starts of the pattern search from the crlb design shaken: how many, and by how much (a fraction of the
 #: region's width per coordinate, normal)
@@ -52,24 +54,11 @@ class Objective:
         return o, oc, short
 
 
-def _directions(n: int) -> np.ndarray:
-    """Unit moves of the compass search: the axes, and for n <= 3 the diagonals of each pair, shape (D, n)."""
-    E = np.eye(n)
-    dirs = [E, -E]
-    if n <= 3:
-        for i in range(n):
-            for j in range(i + 1, n):
-                for si in (1, -1):
-                    for sj in (1, -1):
-                        dirs.append(((si * E[i] + sj * E[j]) / math.sqrt(2))[None])
-    return np.vstack(dirs)
-
-
 def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
     """Pattern search on the penalised objective from the feasible design ``P`` (K, n); returns (P, objective).
 
     Each round tries, at the current step (per coordinate a fraction of the region's width), every move of
-    one pose along one direction (:func:`_directions`) and :data:`POLISH_RANDOM` moves of all the poses at
+    one pose along one direction (:func:`~zerocal_sym.design.certify.directions`) and :data:`POLISH_RANDOM` moves of all the poses at
     once along seeded random directions (they follow a constraint that couples the poses, which single
     moves cannot); the best feasible improvement is taken -- the moved poses feasible
     (:func:`~zerocal_sym.design.constraints._pointwise_ok`), the travel window and the separation kept --,
@@ -79,7 +68,7 @@ def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
     K, n = P.shape
     lo, hi = _region_box(cons, P)
     width = np.maximum(hi - lo, 1e-9)
-    dirs = _directions(n)
+    dirs = directions(n)
     rng = np.random.default_rng(seed)
     T = Terms(robot, P, fn.noise)
     cur = fn.of_terms(T.take(np.arange(K)[None]))[0][0]
@@ -159,7 +148,7 @@ def _window_ok(rho, cons):
 
 def checked_search(robot, K, cons: Constraints, noise, req: Requirement, starts, seed: int = 0,
                    exchange_starts: int = 8, grid=None):
-    """The checked design: exchange on the penalised objective, then order and compass search from it and
+    """The checked design: exchange on the penalised objective, then order and pattern search from it and
     from ``starts`` (a list of ``(label, poses)``: the crlb-optimal design, the baseline).
 
     Returns
@@ -198,7 +187,7 @@ def checked_search(robot, K, cons: Constraints, noise, req: Requirement, starts,
         if check_design(robot, P2, cons):
             P2, o2 = P1, fn(P1)(np.arange(K)[None])[0]
         else:
-            lab += " +compass"
+            lab += " +pattern"
         _, oc, short = fn.of_terms(Terms(robot, P2, noise).take(np.arange(K)[None]))
         tried.append({"label": lab, "objective": float(o2), "crlb_objective": float(oc[0]),
                       "shortfall": float(short[0]), "poses": P2})
