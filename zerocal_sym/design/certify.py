@@ -121,18 +121,9 @@ def screen(X, r, h, k: int = MAX_STARTS) -> np.ndarray:
     half_diag = 0.5 * math.sqrt(X.shape[1])
     bound = r + 2.0 * slope * half_diag
     cand = np.flatnonzero(bound >= 1.0)
-    cand = cand[np.argsort(-bound[cand])]
+    cand = cand[np.argsort(-bound[cand])][:k]
     top = np.argsort(-r)[: max(4, k // 4)]
-    # one start per neighbourhood (within 1.5 spacings of a kept one the search would climb the same hill):
-    # the largest d first, then the largest bounds
-    kept = []
-    for i in np.concatenate([top, cand]):
-        if len(kept) >= k + len(top):
-            break
-        u = X[i] / hs
-        if not kept or np.min(np.linalg.norm(X[kept] / hs - u, axis=1)) > 1.5:
-            kept.append(int(i))
-    return np.array(sorted(kept), int)
+    return np.unique(np.concatenate([cand, top]))
 
 
 def maximise(robot, cons, sens: Sensitivity, X0, h, window):
