@@ -105,25 +105,49 @@ def screen(X, r, h, k: int = MAX_STARTS) -> np.ndarray:
     largest bounds first, at most ``k``; ``r`` (N,) is ``d / s`` at ``X`` (N, n), ``h`` the grid spacing."""
     N = len(X)
     hs = np.broadcast_to(np.asarray(h, float), (X.shape[1],))
-    order = np.argsort(X[:, 0] / hs[0], kind="stable")
-    U = X[order] / hs  # in grid spacings, sorted by the first coordinate
-    rs = r[order]
+    I, J, D = _neighbour_pairs(X / hs, 1.5)  # in grid spacings
     slope = np.zeros(N)
-    B = 256
-    for i0 in range(0, N, B):  # a block against the points within 1.5 spacings of it in the first coordinate
-        blk = U[i0:i0 + B]
-        j0 = int(np.searchsorted(U[:, 0], blk[0, 0] - 1.5, "left"))
-        j1 = int(np.searchsorted(U[:, 0], blk[-1, 0] + 1.5, "right"))
-        D = np.sqrt(np.sum((blk[:, None, :] - U[None, j0:j1, :]) ** 2, axis=2))
-        near = (D > 0) & (D <= 1.5)
-        sl = np.abs(rs[None, j0:j1] - rs[i0:i0 + B, None]) / np.where(near, D, 1.0)
-        slope[order[i0:i0 + B]] = np.max(np.where(near, sl, 0.0), axis=1)
+    np.maximum.at(slope, I, np.abs(r[I] - r[J]) / D)
     half_diag = 0.5 * math.sqrt(X.shape[1])
     bound = r + 2.0 * slope * half_diag
     cand = np.flatnonzero(bound >= 1.0)
     cand = cand[np.argsort(-bound[cand])][:k]
     top = np.argsort(-r)[: max(4, k // 4)]
     return np.unique(np.concatenate([cand, top]))
+
+
+def _neighbour_pairs(U, radius):
+    """All pairs ``(i, j)`` of the points ``U`` (N, n) with ``0 < |U_i - U_j| <= radius`` and their distances.
+
+    The points hashed into cells of side ``radius``; each compared with those of its 3^n neighbouring cells
+    (sorted cell codes and ``searchsorted``: O(3^n N) and the pairs, never N^2).
+    """
+    import itertools
+
+    N, n = U.shape
+    cell = np.floor(U / radius).astype(np.int64)
+    cell -= cell.min(axis=0) - 1
+    mult = np.cumprod(np.concatenate([[1], cell.max(axis=0)[:-1] + 2])).astype(np.int64)
+    code = cell @ mult
+    order = np.argsort(code, kind="stable")
+    sc = code[order]
+    idx = np.arange(N)
+    Is, Js = [], []
+    for o in itertools.product((-1, 0, 1), repeat=n):
+        tgt = code + int(np.dot(o, mult))
+        lo, hi = np.searchsorted(sc, tgt, "left"), np.searchsorted(sc, tgt, "right")
+        cnt = hi - lo
+        if not cnt.any():
+            continue
+        start = np.repeat(lo - (np.cumsum(cnt) - cnt), cnt)
+        Is.append(np.repeat(idx, cnt))
+        Js.append(order[start + np.arange(int(cnt.sum()))])
+    if not Is:
+        return np.zeros(0, int), np.zeros(0, int), np.zeros(0)
+    I, J = np.concatenate(Is), np.concatenate(Js)
+    D = np.sqrt(np.sum((U[I] - U[J]) ** 2, axis=1))
+    keep = (D > 0) & (D <= radius)
+    return I[keep], J[keep], D[keep]
 
 
 def maximise(robot, cons, sens: Sensitivity, X0, h, window):
