@@ -53,13 +53,14 @@ def add_arguments(p):
     p.add_argument("--bias-model", choices=["rms", "worst"], default="rms",
                    help="how --criterion mse counts the bias: rms (expected, errors uniform within the "
                         "tolerances; default) or worst (the worst case within them)")
-    p.add_argument("--power", type=float, default=None, metavar="P",
-                   help="the power the fit check of a checked design keeps against each error it must see "
-                        "(default 0.9)")
-    p.add_argument("--bad-reading-mm", type=float, default=None, metavar="MM",
-                   help="the size of the one bad reading a design is judged against, mm (default 0.1)")
-    p.add_argument("--fit-alpha", type=float, default=None, metavar="A",
-                   help="the level of the fit check a design is judged with (default 0.001, identify's)")
+    from zerocal_sym.design import power as pw
+
+    p.add_argument("--power", type=float, default=pw.DEFAULT_POWER, metavar="P",
+                   help="the power the fit check of a checked design keeps against each error it must see")
+    p.add_argument("--bad-reading-mm", type=float, default=pw.DEFAULT_BAD_READING_MM, metavar="MM",
+                   help="the size of the one bad reading a design is judged against, mm")
+    p.add_argument("--fit-alpha", type=float, default=pw.DEFAULT_ALPHA, metavar="A",
+                   help="the level of the fit check a design is judged with (identify's)")
     p.add_argument("--target-crlb", type=float, default=None, metavar="X",
                    help="the fewest poses whose design reaches this RMS zero-offset CRLB, in the joints' unit: deg "
                         "for revolute, mm for prismatic joints; the region and constraint options apply")
