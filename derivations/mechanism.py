@@ -380,6 +380,25 @@ def numeric_value(solve, A, B):
     return np.linalg.solve(A, B)
 
 
+#: the name of the optional drawing output (:func:`sketch_output`): the report draws the robot with it
+SKETCH = "sketch"
+
+
+def sketch_output(mech: SymbolicMechanism, segments) -> dict:
+    """The optional ``sketch`` output: the robot drawn as line segments, for the calibration report.
+
+    ``segments``: ``[(start, end)]``, each end a point (``sp.Matrix`` of l coordinates, mm: the measuring
+    mechanism's dimension, 2 or 3) in the pose, the joints and the geometry.  The generated function
+    ``sketch(P, theta, g)`` returns them as one (l, 2 s) matrix: columns ``2k`` and ``2k + 1`` are the ends of
+    segment ``k``.  Put it in ``extra_outputs``; a mechanism without one is drawn by its measuring mechanism
+    and its poses alone.
+    """
+    cols = [pt for seg in segments for pt in seg]
+    return dict(inputs=[("P", list(mech.pose)), ("theta", list(mech.joints)), ("g", list(mech.geometry))],
+                outputs=[("segments", sp.Matrix.hstack(*cols))],
+                doc="The robot drawn as line segments (columns 2k and 2k+1: the ends of segment k), mm.")
+
+
 def measuring_vector(mech: SymbolicMechanism):
     """The nominal measuring-mechanism vector ``O2 - O1`` (default ``lambda = P - c - d``)."""
     return mech.measuring_vector

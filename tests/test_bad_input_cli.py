@@ -151,7 +151,8 @@ def test_bom_and_crlf_are_accepted(capsys, tmp_path):
 ROBOT_CASES = {
     "wrong units": (lambda t: t.replace('units = "mm"', 'units = "m"'), "units",
                     r"units = 'm' is not supported: robot files are in mm"),
-    "unknown key": (lambda t: t + "wheelbase = 3\n", "wheelbase", r"unknown key 'wheelbase'"),
+    "unknown key": (lambda t: t.replace("dy = 51\n", "dy = 51\nwheelbase = 3\n"), "wheelbase",
+                    r"unknown key 'wheelbase'"),  # (among the top-level keys, before the [tolerances] table)
     "missing key": (lambda t: t.replace("cy = 79\n", ""), None, r"missing key\(s\): cy"),
     "not a number": (lambda t: t.replace("H = 632", 'H = "632"'), "H", r"key 'H' must be a number"),
     "metres": (lambda t: "\n".join(ln for ln in t.split("\n") if not ln.startswith("units")).replace(

@@ -605,3 +605,15 @@ def test_arrays_nested_thousands_deep(base, where):
         assert rc == 2 and len(err.strip().splitlines()) == 1 and "nested too deeply" in err, err
         if line is not None:
             assert f"{f.name}:{line}: " in err, err
+
+
+@fuzz(8)
+@given(case=result_mutated())
+def test_result_files_in_the_report(base, case):
+    """``zerocal report`` reads more of a results file than the others (the fit's record, the covariance, the
+    residuals, the bias, an error budget): never a traceback either."""
+    mech, edits, _ = case
+    with workdir(base) as t:
+        res = t / "r.json"
+        res.write_text(mutate_json(base[mech]["result_text"], edits))
+        check(["report", res, "--robot", base[mech]["robot"], "--data", base[mech]["data"], "--out", t / "r.html"])

@@ -66,3 +66,24 @@ def test_reproduce_progress_off_a_terminal_is_a_few_lines(monkeypatch):
         report(done, 128)
     lines = log.getvalue().splitlines()
     assert 1 <= len(lines) <= 4 and "128/128" in lines[-1]
+
+
+def test_design_optimize_shows_progress_on_a_terminal_only(monkeypatch):
+    """``design --optimize`` (tens of seconds): a tqdm bar on stderr when it is a terminal, its steps counted to
+    the end (the approximate design, each exchange and Ipopt start, the polish); nothing in a log."""
+    from zerocal_sym.cli._design_optimize import progress_bar
+
+    assert progress_bar(io.StringIO()) is None  # a log, a pipe: quiet
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty = Tty()
+    monkeypatch.setattr("sys.stderr", tty)
+    assert main(["design", "--optimize", "--K", "5", "--starts", "1", "--json"]) == 0
+    monkeypatch.undo()
+    bar = tty.getvalue()
+    steps = 1 + 1 + 1 + 1 + 2  # the certificate's approximate design, one exchange start, the scheme and one random
+    # Ipopt start, the polish of the two candidates
+    assert "design" in bar and f"{steps}/{steps}" in bar, bar

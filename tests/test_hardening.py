@@ -157,9 +157,9 @@ def test_reproduce_out_must_be_a_directory_not_an_input(capsys, tmp_path, files)
     ["identify", ""],
     ["robot", "--robot", ""],
 ])
-def test_empty_file_name_is_an_error(capsys, tmp_path, files, argv):
+def test_empty_file_name_is_an_error(capsys, tmp_path, files, argv, monkeypatch):
     argv = [{"DATA": files["data"], "DATA2": files["data2"], "RESULT": files["result"]}.get(a, a) for a in argv]
-    os.chdir(tmp_path)
+    monkeypatch.chdir(tmp_path)  # restored after the test: the next tests' relative paths are the checkout's
     line = one_line_error(capsys, argv)
     assert "empty" in line
     assert list(tmp_path.iterdir()) == []
@@ -372,9 +372,10 @@ def test_options_of_other_commands(capsys, tmp_path, files, argv, pattern):
     ("L = 375\nhome = [1e300, 180]", "home must be 2 finite joint angles"),
 ])
 def test_robot_file_numbers_too_large(capsys, tmp_path, text, pattern):
-    base = "\n".join(line for line in ROBOT_TOML.splitlines() if not line.startswith("L "))
+    top, table = ROBOT_TOML.split("\n[tolerances]")  # (the keys go among the top-level ones, before the table)
+    base = "\n".join(line for line in top.splitlines() if not line.startswith("L "))
     f = tmp_path / "r.toml"
-    f.write_text(base + "\n" + text + "\n")
+    f.write_text(base + "\n" + text + "\n\n[tolerances]" + table)
     for command in (["robot"], ["identify", str(EXAMPLE)]):
         one_line_error(capsys, command + ["--robot", f], pattern)
 
@@ -382,7 +383,7 @@ def test_robot_file_numbers_too_large(capsys, tmp_path, text, pattern):
 @pytest.mark.parametrize("poses, pattern", [
     ("x_mm,y_mm\n-240,632\n0,632\n240,632\n0,782\n", "4 poses give 3 measured changes: too few"),
     ("x_mm,y_mm\n-240,632\n-120,632\n0,632\n120,632\n240,632\n-60,632\n", "lie on one straight line"),
-    ("x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n0,632\n", "pose 5: repeats the"),
+    ("x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n0,632\n", "pose 5 repeats the target of pose 1"),
     ("x_mm,y_mm\n-240,632\n0,632\n240,632\n-240,782\n0,782\n900,782\n", "outside the workspace"),
 ])
 def test_template_refused_where_identify_would_refuse(capsys, tmp_path, files, poses, pattern):
@@ -416,7 +417,7 @@ def fuzz_cases():
               None: ["", "nan", "-1"]}
     base = {"simulate": ["--group", "1", "--out", "OUT"], "identify": ["DATA", "--method", "tsvd"],
             "compensate": ["RESULT", "--out", "OUT"], "verify": ["RESULT", "DATA2", "--out", "OUT"],
-            "design": [], "robot": []}
+            "design": [], "robot": [], "report": ["RESULT", "--out", "OUT"]}
     skip = {"--set", "--group", "--method", "--out", "--robot", "--plot", "--poses", "--params", "--prior-std",
             "--bound", "--max-iter", "--truncation", "--rule"}
     from zerocal_sym.cli import build_parser

@@ -141,6 +141,33 @@ def test_sigterm_removes_the_temporary_directory(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("what", ["directory", "file"])
+def test_a_stop_right_after_the_temporary_is_made_leaves_nothing(tmp_path, monkeypatch, what):
+    """A Ctrl-C that arrives just as the temporary directory or file is made -- before its name is recorded for
+    the cleanup -- acts once the name is known: nothing is left (the race behind a hidden .rep.*.tmp after
+    SIGTERM on a loaded machine).  The signal is raised inside tempfile's call, deterministically."""
+    import tempfile
+
+    from zerocal_sym.io import files
+
+    name = "mkdtemp" if what == "directory" else "mkstemp"
+    real = getattr(tempfile, name)
+
+    def then_a_stop(*args, **kwargs):
+        out = real(*args, **kwargs)
+        signal.raise_signal(signal.SIGINT)  # Python's default handler: KeyboardInterrupt at the next check
+        return out
+
+    monkeypatch.setattr(tempfile, name, then_a_stop)
+    with pytest.raises(KeyboardInterrupt):
+        if what == "directory":
+            with files.staged_directory(tmp_path / "out") as d:
+                (d / "a.txt").write_text("a")
+        else:
+            files.atomic_write_text(tmp_path / "out.txt", "a")
+    assert list(tmp_path.iterdir()) == []
+
+
 # --------------------------------------------------------------------------- a signal after the outputs
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])

@@ -2,6 +2,7 @@
 simulate -> identify round trip (set values recovered within the noise)."""
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -70,6 +71,16 @@ def test_walkthrough(capsys, tmp_path, monkeypatch):
     assert res["robot_sha256"] == robot.sha256 and res["success"]
     for key in ("zero_offsets_deg", "maemm_mm", "std_zero_offsets_deg", "method", "status", "covariance", "units"):
         assert key in res, key
+
+    # 4, the calibration report: the line the page prints, and the accuracy the page shows (data-value: the full
+    # number; the page shows it to 4 significant digits, as the walkthrough quotes it)
+    out = zc(capsys, "report", "result1.json", *R, "--data", "round1.csv", "--out", "report.html")
+    doc = (ROOT / "docs" / "walkthrough.md").read_text()
+    assert out.strip() in doc, out
+    page = Path("report.html").read_text()
+    accuracy = page[page.index('<section id="accuracy">'):]
+    before, std_at, _, after = (float(v) for v in re.findall(r'data-value="([^"]+)"', accuracy)[:4])
+    assert f"at most {before:.4g} mm (1σ {std_at:.4g} mm) before and at most {after:.4g} mm after" in doc
 
     # 5. apply: the controller's table and the compensated commands
     zc(capsys, "compensate", "result1.json", *R, "--out", "compensation.csv")

@@ -35,7 +35,8 @@ from __future__ import annotations
 import sympy as sp
 
 from derivations.geometry import trilaterate
-from derivations.mechanism import HOME_WORKSPACE_CENTRE, SourceError, SymbolicMechanism, derive
+from derivations.mechanism import (HOME_WORKSPACE_CENTRE, SKETCH, SourceError, SymbolicMechanism, derive,
+                                   sketch_output)
 
 TOWERS = (1, 2, 3)
 
@@ -132,4 +133,12 @@ def build() -> SymbolicMechanism:
         gauge_fix=("rMz", "R1", "phi1", "phi2"),
         noise={"scale": 0.002, "joint": 0.005},
     )
+    # the drawing: the towers' feet on the bed, each tower up to its carriage A_i, the rod A_i C_i, the effector
+    foot = [R[i] * e[i] for i in range(3)]
+    A = [foot[i] + s[i] * ez for i in range(3)]
+    C = [P + r * e[i] for i in range(3)]
+    ring = [(i, (i + 1) % 3) for i in range(3)]
+    mech.extra_outputs = {SKETCH: sketch_output(mech, [(foot[i], foot[j]) for i, j in ring]
+                                                + [seg for i in range(3) for seg in ((foot[i], A[i]), (A[i], C[i]))]
+                                                + [(C[i], C[j]) for i, j in ring])}
     return derive(mech)

@@ -32,7 +32,7 @@ from __future__ import annotations
 import sympy as sp
 
 from derivations.geometry import trilaterate
-from derivations.mechanism import SourceError, SymbolicMechanism, derive
+from derivations.mechanism import SKETCH, SourceError, SymbolicMechanism, derive, sketch_output
 
 LIMBS = (1, 2, 3)
 
@@ -123,4 +123,9 @@ def build() -> SymbolicMechanism:
         positive=("R1", "R2", "R3", "L1", "L2", "L3", "l1", "l2", "l3", "r"),
         gauge_fix=("z1", "phi1"),  # shoulder 1 at its nominal height and azimuth
     )
+    # the drawing: the shoulders' triangle, each upper arm A_i B_i and forearm B_i C_i, the platform's triangle
+    ring = [(i, (i + 1) % 3) for i in range(3)]
+    mech.extra_outputs = {SKETCH: sketch_output(mech, [(A[i], A[j]) for i, j in ring]
+                                                + [seg for i in range(3) for seg in ((A[i], B[i]), (B[i], C[i]))]
+                                                + [(C[i], C[j]) for i, j in ring])}
     return derive(mech)

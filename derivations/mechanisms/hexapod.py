@@ -34,7 +34,8 @@ from __future__ import annotations
 import sympy as sp
 
 from derivations.geometry import cross, norm
-from derivations.mechanism import Determinant, FkSolve, SourceError, SymbolicMechanism, derive
+from derivations.mechanism import (SKETCH, Determinant, FkSolve, SourceError, SymbolicMechanism, derive,
+                                   sketch_output)
 
 LEGS = (1, 2, 3, 4, 5, 6)
 #: the rotation columns of the singularity indicator's matrix are scaled by this length (mm)
@@ -156,4 +157,9 @@ def build() -> SymbolicMechanism:
         gauge_fix=("b1x", "b1y", "b1z", "b2x", "b2z", "b3z", "q1x", "q1y", "q1z", "q2x", "q2z", "q3z"),
         noise={"scale": 0.001, "joint": 0.002},
     )
+    # the drawing: the base's and the platform's hexagons (the joints in leg order) and the six legs
+    T = [P + Rot * p[i] for i in range(6)]
+    ring = [(i, (i + 1) % 6) for i in range(6)]
+    mech.extra_outputs = {SKETCH: sketch_output(mech, [(B[i], B[j]) for i, j in ring] + [(T[i], T[j]) for i, j in ring]
+                                                + [(B[i], T[i]) for i in range(6)])}
     return derive(mech)

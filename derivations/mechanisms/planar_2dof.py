@@ -28,7 +28,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from derivations.mechanism import SourceError, SymbolicMechanism, derive, implicit_pose_jacobian
+from derivations.mechanism import (SKETCH, SourceError, SymbolicMechanism, derive, implicit_pose_jacobian,
+                                   sketch_output)
 
 Q = sp.Matrix([[0, -1], [1, 0]])
 
@@ -136,6 +137,8 @@ def build() -> SymbolicMechanism:
         "error_jacobian_full": dict(
             inputs=[("P", [x, y]), ("theta", [th1, th2]), ("g", list(geo))], outputs=[("J_full", J_full)],
             doc="Paper Eq. (12): dP = J' dq', dq' = (L1 dth1, de1x, de1y, dL1, dl1, L2 dth2, ...)."),
+        # the drawing: the base A1 A2, each limb's proximal link A_i B_i and distal link B_i P
+        SKETCH: sketch_output(mech, [(e[0], e[1])] + [seg for i in range(2) for seg in ((e[i], B[i]), (B[i], P))]),
     }
     derive(mech)
     mech.paper_forms = paper_forms(P, th, e, L, ll)

@@ -83,7 +83,25 @@ def scheme_poses(robot, scheme=None, n=None, identifiable: bool = True, option: 
     return robot.workspace.boundary_scheme(n), n
 
 
-def poses_arg(robot, spec, n, identifiable: bool = True):
+def add_revisits_argument(p, what: str = "the measurement file") -> None:
+    """``--allow-revisits`` (a command that reads measurement or pose files)."""
+    p.add_argument("--allow-revisits", action="store_true",
+                   help=f"accept a pose visited again after other poses in {what} (a design's replicates) "
+                        "without its '# revisits: allowed' line; a pose repeated right after itself is refused "
+                        "either way")
+
+
+def revisits_meta(P) -> dict:
+    """``{"revisits": "allowed"}`` when the poses ``P`` (K, n) revisit a pose, else ``{}``: what a file made
+    of them says (a file zerocal writes with revisits says they are intended)."""
+    from zerocal_sym.io.csvtext import REVISITS_ALLOWED, REVISITS_KEY
+    from zerocal_sym.model.revisits import REVISIT_TOL, pose_groups
+
+    lab = pose_groups(P, REVISIT_TOL)
+    return {REVISITS_KEY: REVISITS_ALLOWED} if lab.size and lab.max() + 1 < lab.size else {}
+
+
+def poses_arg(robot, spec, n, identifiable: bool = True, allow_revisits: bool = False):
     """Poses from ``--poses SCHEME|FILE`` (None: the robot's scheme) with ``--n``.
 
     Returns
@@ -95,17 +113,20 @@ def poses_arg(robot, spec, n, identifiable: bool = True):
         return P, f"{robot.workspace.scheme_name} scheme, n = {n}"
     from zerocal_sym.io.poses import load_poses
 
-    return load_poses(spec, robot), str(spec)
+    return load_poses(spec, robot, allow_revisits, measured=True), str(spec)
 
 
-def check_round_poses(robot, P, theta_cmd, source: str) -> None:
+def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = False, region=None) -> None:
     """Refuse a measurement round (``compensate --template``) that identify would refuse.
 
     The checks of ``zerocal identify`` on the poses themselves: enough poses
     for the p = m + n parameters (and the loader's minimum), every pose
     inside the workspace, reachable and away from singular configurations
-    (the robot's singularity margin), no pose repeated, the poses not on one
-    line, and the paper's identification matrix G of full rank.
+    (the robot's singularity margin), no pose repeated right after itself
+    (nor after other poses, unless ``allow_revisits``), the poses not on one
+    line, and the paper's identification matrix G of full rank.  ``region``:
+    the region a design's poses carry (:func:`zerocal_sym.io.poses.load_design_poses`),
+    whose singularity margin replaces the workspace check.
 
     Raises
     ------
@@ -128,19 +149,28 @@ def check_round_poses(robot, P, theta_cmd, source: str) -> None:
     if K < need:
         raise PoseError(f"{K} poses give {K - 1} measured changes: too few for the {p} parameters ({names}); a "
                         f"measurement round needs at least {need} poses ({why})", where=source)
-    try:
-        theta = kin.check_poses(robot, P, in_workspace=True)
+    try:  # a design's own region (load_design_poses): its margin, not the workspace
+        theta = (kin.check_poses(robot, P, in_workspace=True) if region is None
+                 else kin.check_poses(robot, P, margin=region["region_singularity_margin"]))
     except PoseError as exc:
         raise PoseError(f"{exc.where}: {exc.message} ({why})" if exc.where else f"{exc.message} ({why})",
                         where=source) from None
     from zerocal_sym.model import units
 
+    from zerocal_sym.io.measurement_checks import revisit_hint
+    from zerocal_sym.model.revisits import consecutive_repeat
+
     for what, X, tol in ((f"commanded {units.joint_noun(robot)}", units.joints_to_user(robot, theta_cmd), 1e-9),
                          ("target", P, 1e-9)):
-        dup = first_duplicate(X, tol)
+        k = consecutive_repeat(X, tol)
+        if k is not None:
+            raise PoseError(f"pose {k}: repeats the {what} of the pose before it, a zero change ({why})",
+                            where=source)
+        dup = None if allow_revisits else first_duplicate(X, tol)
         if dup is not None:
             k, j = dup
-            raise PoseError(f"pose {k}: repeats the {what} of pose {j} ({why})", where=source)
+            raise PoseError(f"pose {k}: repeats the {what} of pose {j}, {revisit_hint('pose file')} ({why})",
+                            where=source)
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if spread[1] <= COLLINEAR_RTOL * spread[0]:
         raise PoseError(f"the {K} poses lie on one straight line: the offsets and the MAEMM are not identifiable "
@@ -148,8 +178,12 @@ def check_round_poses(robot, P, theta_cmd, source: str) -> None:
     G, _ = identification_matrix(robot, P, theta=theta)
     s = np.linalg.svd(G, compute_uv=False)
     if not s[-1] > RANK_RTOL * s[0]:
+        from zerocal_sym.identify.identifiability import null_space_phrase
+
+        null = null_space_phrase(robot, theta, robot.errors.resolve("default"))
         raise PoseError(f"the identification matrix G of these poses has rank {int(np.sum(s > RANK_RTOL * s[0]))} "
-                        f"< {p}: the parameters {names} are not identifiable from them ({why})", where=source)
+                        f"< {p}: the parameters {names} are not identifiable from them"
+                        + (f" ({null})" if null else "") + f" ({why})", where=source)
 
 
 # --------------------------------------------------------------------------- values by name

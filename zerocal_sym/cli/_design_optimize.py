@@ -6,7 +6,8 @@ of the design beside the paper's scheme with the same K, the CRLB of the zero
 offsets and their ratio; ``--verify N`` adds a Monte Carlo with the Ipopt
 estimator (:func:`zerocal_sym.design.verify_design`) for both designs;
 ``--plot PNG`` draws them in the workspace.  Nothing is written (plot) unless
-everything succeeded.
+everything succeeded.  On a terminal a progress bar (tqdm) counts its steps
+on stderr; in a log or a pipe it is quiet.
 
 Any mechanism: the design region is the robot's workspace shape (a rectangle
 ``XMIN XMAX YMIN YMAX``, a cylinder ``RW ZMIN ZMAX``, a box ``X_MIN X_MAX ...
@@ -42,8 +43,10 @@ def add_arguments(p):
                    help="exact (exchange + Ipopt), approx (the optimal design measure, rounded, with a "
                         "certificate) or auto: exact up to K = 24 (default)")
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
-                   help="tolerance of an error the identification leaves out (mm; deg for angles), repeatable; "
-                        "default: set A of Table 2 (planar), 0.02 mm per length and 0.002 deg per angle (others)")
+                   help="tolerance of an error the identification leaves out, or of a group of them (L for L1 L2 "
+                        "L3) (mm; deg for angles), repeatable; default the robot file's [tolerances], else 0.5 mm "
+                        "per length and 0.05 deg per angle (a robot measured by hand; the paper's robot: Table 2's "
+                        "set A)")
     from zerocal_sym.cli._paths import InputFile
 
     p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
@@ -161,10 +164,12 @@ def constraints_from_args(robot, args):
 
 def tolerances_from_args(robot, args):
     """Tolerances of the omitted errors (internal units) from ``--tolerance``, ``--tolerance-file``, ``--tolerance-scale``."""
+    from zerocal_sym.design.terms import design_params
     from zerocal_sym.identify.bias import make_tolerances
 
     return make_tolerances(robot, getattr(args, "tolerance", None) or [], getattr(args, "tolerance_file", None),
-                           getattr(args, "tolerance_scale", 1.0), bias_model=getattr(args, "bias_model", "rms"))
+                           getattr(args, "tolerance_scale", 1.0), params=design_params(robot),
+                           bias_model=getattr(args, "bias_model", "rms"))
 
 
 def requirement_from_args(robot, args, tolerances):
@@ -189,6 +194,32 @@ def _fmt(v, spec=".4g"):
     if isinstance(v, float) and not math.isfinite(v):
         return str(v)
     return format(v, spec)
+
+
+class _Bar:
+    """``progress(done, total)`` of :func:`zerocal_sym.design.optimize_design` as a tqdm bar on stderr."""
+
+    def __init__(self, stream):
+        self.stream, self.bar = stream, None
+
+    def __call__(self, done, total):
+        from zerocal_sym.identify.progress import Progress
+
+        if self.bar is None:
+            self.bar = Progress(total, "design", stream=self.stream, unit="step")
+        self.bar(done)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def progress_bar(stream=None):
+    """A progress bar on a terminal (tqdm, as compare's); none when stderr is not one (a log, a pipe: quiet)."""
+    import sys
+
+    stream = sys.stderr if stream is None else stream
+    return _Bar(stream) if getattr(stream, "isatty", lambda: False)() else None
 
 
 def run(args, robot):
@@ -228,15 +259,40 @@ def run(args, robot):
                                  "--method approx takes any K)")
     cons = constraints_from_args(robot, args)
     noise = NoiseModel.named(getattr(args, "noise", "paper"), robot)
+    choice = None
+    if getattr(args, "choose_params", False):  # the set too: the least expected offset error at K
+        import sys
+
+        from zerocal_sym.design.choose import choose_design_params
+
+        if not args.json:
+            print(f"choosing the parameter set (approximate designs, K = {K}):", file=sys.stderr)
+        crit = "crlb" if args.criterion == criteria.CHECKED else args.criterion  # (the set by the CRLB alone)
+        choice = choose_design_params(robot, K, crit, cons, noise, tol, seed=args.seed, starts=starts,
+                                      progress=None if args.json else lambda line: print(line, file=sys.stderr))
+        robot = robot.identifying(choice["chosen"])
     req = requirement_from_args(robot, args, tol)
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
+    bar = progress_bar()
     try:
         res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
-                                     exchange_starts=starts, tolerances=tol, method=method, requirement=req)
+                                     exchange_starts=starts, tolerances=tol, method=method, progress=bar,
+                                     requirement=req)
     except BaseException:
         _parallel.close(ex)
         raise
+    finally:
+        if bar is not None:
+            bar.close()
     out = res.to_dict()
+    from zerocal_sym.design.terms import design_params
+
+    out["params"] = list(design_params(robot))
+    out["params_spec"] = robot.identified_set
+    if choice is not None:
+        from zerocal_sym.io.files import json_safe
+
+        out["params_choice"] = json_safe(choice)
     out["robot"] = robot.name
     out["mechanism"] = robot.mechanism_name
     out["seed"] = args.seed
@@ -286,10 +342,18 @@ def _print_text(out, res, robot):
     pu = out.get("pose_units") or pose_units(robot)
     print(f"Optimised measurement poses: robot {out['robot']}, K = {out['K']}, criterion {crit} "
           f"({_desc(crit)})")
+    if out.get("params_choice"):
+        ch = out["params_choice"]
+        print(f"parameters chosen: {ch['chosen']} (expected offset error {_fmt(ch['expected'])} {ch['unit']} at "
+              f"its design; {ch['base']} alone {_fmt(ch['base_expected'])} {ch['unit']}; {len(ch['table'])} sets, "
+              f"{ch['search']})")
+    if out.get("params") and out["params"] != list(robot.errors.resolve("paper")):
+        print(f"designed for identifying: {', '.join(out['params'])} (then: zerocal identify ... --params "
+              f"{out['params_spec']})")
     region = c["region"] + (" mm" if set(pu) == {"mm"} or c["region_kind"] != "box" else "")
     print(f"constraints: region {region}; scale range l0 = {c['travel_mm']:g} mm ({c['travel_mode']}); "
           f"|sin transmission| >= {c['singularity_margin']:g}; joint limits "
-          f"{'none' if jl is None else str(jl) + ' ' + ju}; poses >= {c['min_separation_mm']:g} mm apart"
+          f"{'none' if jl is None else str(jl) + ' ' + ju}; distinct poses >= {c['min_separation_mm']:g} mm apart"
           + ("" if set(pu) == {"mm"} else " (a degree counts as a mm)"))
     n = out["noise"]
     print(f"noise: scale {n['sigma_scale_mm'] * 1e3:.4g} um per change, {'servo' if ju == 'deg' else 'joint'} "
@@ -469,6 +533,9 @@ def _run_target(args, robot):
            "bound": "no design of fewer than K_lower_bound poses on the candidate poses reaches the target "
                     "(certificate of the optimal design measure); K is the fewest poses of the rounded designs",
            "time_s": res["time_s"]}
+    from zerocal_sym.design.replicates import revisits_entry
+
+    out.update(revisits_entry(P))  # true replicates: a pose file of the design says revisits are intended
     from zerocal_sym.identify import fisher
 
     out[k("crlb_zero_offsets")] = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise).tolist()
@@ -486,6 +553,9 @@ def _run_target(args, robot):
           f"region {region_text(cons.region)}")
     print(f"  K = {out['K']} (design CRLB {out[k('crlb_rms')]:.5g} {ju}; per offset "
           f"{', '.join(f'{v:.5g}' for v in out[k('crlb_zero_offsets')])})")
+    if out.get("revisits"):
+        print(f"  the poses are replicates of {len(np.unique(P, axis=0))} support points, never one twice in a row "
+              "(the JSON says \"revisits\": \"allowed\": its readers accept them)")
     print(f"  certified: no design of fewer than {out['K_lower_bound']} poses on the "
           f"{out['approximate']['n_candidates']} candidate poses can reach it")
     a = out["approximate"]

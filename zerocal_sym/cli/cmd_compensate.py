@@ -69,6 +69,9 @@ def add_arguments(p):
                    help="rrf: the M665 H (homed height, mm) to write (default: left out, RRF keeps its own)")
     p.add_argument("--out", metavar="FILE", default=None, type=OutputFile(), help="output file (default: print)")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the pose file (--poses)")
 
 
 def check_result_robot(res, robot, where):
@@ -87,14 +90,14 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.cli._common import check_round_poses, scheme_poses
+    from zerocal_sym.cli._common import check_round_poses, revisits_meta, scheme_poses
     from zerocal_sym.errors import DataFileError, ZerocalError
     from zerocal_sym.io.compensation import compensated_commands, format_commands, format_compensation, format_offsets
     from zerocal_sym.io.results import sign_convention
     from zerocal_sym.model import units
     from zerocal_sym.io.files import atomic_write_text, to_json
     from zerocal_sym.io.measurements import format_template
-    from zerocal_sym.io.poses import load_poses
+    from zerocal_sym.io.poses import load_design_poses
     from zerocal_sym.io.results import load_result
 
     robot = load_robot_arg(args)
@@ -138,15 +141,19 @@ def run(args):
         text, what, K = format_compensation(res, {"result": args.result}, mechanism=robot), "compensation table", 0
     else:
         if args.poses is not None:
-            P, source = load_poses(args.poses, robot), args.poses
+            (P, region), source = load_design_poses(args.poses, robot, args.allow_revisits, measured=args.template), \
+                args.poses
         else:
             P, n = scheme_poses(robot, args.scheme, args.n, identifiable=args.template)
-            source = f"--scheme {args.scheme} --n {n}"
+            source, region = f"--scheme {args.scheme} --n {n}", None
         nominal, cmd = compensated_commands(robot, P, offsets)
         K = len(P)
         if args.template:  # a round identify would refuse is refused now, not after the measurements
-            check_round_poses(robot, P, cmd, source)
+            check_round_poses(robot, P, cmd, source, allow_revisits=True,  # (the pose file's revisits: read so)
+                              region=region)
             meta[units.joint_key(robot, "compensation")] = format_offsets(offsets)
+            meta.update(revisits_meta(P))  # the template says its revisits are intended
+            meta.update(region or {})  # a design's own region travels with its poses
             text, what = format_template(cmd, P, meta, mechanism=robot), "measurement template"
         else:
             text, what = format_commands(P, nominal, cmd, offsets, meta, mechanism=robot), "compensated commands"

@@ -29,7 +29,11 @@ right one.
 ``--optimize``: K poses chosen by a constrained optimisation (CasADi/Ipopt
 and a discrete exchange, or the approximate design with its certificate) for
 a criterion, over the robot's workspace shape (a rectangle, a cylinder, a
-box), compared with the boundary scheme at the same K.
+box), compared with the boundary scheme at the same K.  ``--params SET``: the
+design is made for identifying SET (default ``paper``, the zero offsets and
+the MAEMM; e.g. ``paper+L1,L2,L3`` to identify the upper arms too, then
+``zerocal identify --params paper+L1,L2,L3``); ``--choose-params``: the set
+too, the one whose offsets' expected error at K is least (docs/trust.md).
 """
 NAME = "design"
 HELP = "measurement poses: the robot's boundary scheme (paper, ring, corners) or an optimised design"
@@ -85,14 +89,21 @@ def add_arguments(p):
     p.add_argument("--joint-limits-mm", nargs="+", type=float, metavar="MM", default=None,
                    help="--joint-limits spelt with its unit (prismatic joints)")
     p.add_argument("--min-separation", type=float, default=1.0, metavar="MM",
-                   help="min distance between two poses in mm; for a pose with orientations a degree counts as a "
-                        "mm (--optimize; default 1)")
+                   help="min distance between two distinct poses in mm (a replicate is the same pose again); for "
+                        "a pose with orientations a degree counts as a mm (--optimize; default 1)")
     p.add_argument("--noise", choices=["default", "paper", "scale-only", "servo-only", "joint-only"],
                    default="default",
                    help="noise model of the Fisher-information criteria (--optimize): the robot's (default: its "
                         "file's [noise], its mechanism's, else the paper's Eqs. 34-35; 'paper' is the same), its "
                         "scale term alone, its joint term alone (servo-only = joint-only)")
     p.add_argument("--starts", type=int, default=8, help="random Ipopt starts and exchange starts (--optimize)")
+    p.add_argument("--params", default="paper", metavar="SET",
+                   help="the parameters the design is for (--optimize): paper (default: the zero offsets and the "
+                        "MAEMM) or names and sets joined by + or , (e.g. paper+L1,L2,L3: the upper arms too)")
+    p.add_argument("--choose-params", action="store_true",
+                   help="(--optimize) also choose the set: of --params plus whole groups of robot-file entries "
+                        "(L for L1 L2 L3), the one whose offsets' expected error (variance of what is identified, "
+                        "squared bias from the tolerances of what is held) is least at K")
     from zerocal_sym.cli import _design_optimize
 
     _design_optimize.add_arguments(p)  # --bounds, --method, --tolerance..., --target-crlb
@@ -106,6 +117,7 @@ def run(args):
 
     robot = load_robot_arg(args)
     resolve_unit_options(args, robot)
+    robot = _identifying(args, robot)
     if args.optimize or getattr(args, "target_crlb", None) is not None:
         from zerocal_sym.cli import _design_optimize
 
@@ -118,3 +130,24 @@ def run(args):
     from zerocal_sym.cli import _design_scheme
 
     return _design_scheme.run(args, robot)
+
+
+def _identifying(args, robot):
+    """The robot with the set of ``--params`` (the designs are made for it); ``--params`` and
+    ``--choose-params`` are for ``--optimize``."""
+    from zerocal_sym.errors import ZerocalError
+
+    params = getattr(args, "params", "paper")
+    if params == "paper" and not getattr(args, "choose_params", False):
+        return robot
+    if not args.optimize:
+        raise ZerocalError("--params and --choose-params are for --optimize (a design made for that set)")
+    try:
+        robot = robot.identifying(params)
+    except ValueError as exc:
+        raise ZerocalError(f"--params: {exc}") from None
+    missing = [z for z in robot.errors.zero_offsets if z not in robot.errors.resolve(params)]
+    if missing:
+        raise ZerocalError(f"--params {params}: the zero offsets {', '.join(missing)} must be among them (a design "
+                           "is made for the offsets)")
+    return robot

@@ -11,7 +11,11 @@ priors (MAP) and bounds.  ``--method tsvd``: the paper's truncated SVD of the
 linearised model (Eq. 29): the m zero offsets and the n MAEMM components.
 
 Output: the zero offsets with their standard deviations, the MAEMM, the
-solver status, the identifiability of the parameters from these poses, and
+solver status, the identifiability of the parameters from these poses, the
+error budget of the offsets (their 1 sigma from the data against the bias the
+robot-file entries held at their values can put on them within their
+``[tolerances]``; ``error_budget`` and ``limited_by`` in the JSON:
+:mod:`zerocal_sym.identify.budget`, docs/trust.md), and
 the compensation (sign convention: ``theta_cmd = IK(P) - offset``; the actual
 joint angle is the commanded one plus the offset).  ``--json`` prints the
 results JSON that ``zerocal compensate`` reads; ``--out`` writes it
@@ -25,17 +29,16 @@ Examples:
     zerocal identify round1.csv --method tsvd
     zerocal identify round1.csv --params paper+L1,L2 --prior-std L1=0.05 --prior-std L2=0.05
     zerocal identify d.csv --robot examples/delta.toml --maemm-prior 1 0.5 -0.5 --json
+    zerocal identify d.csv --robot examples/delta_arms.toml --params auto --test-groups
 """
+from zerocal_sym.cli._identify_text import SIGMA_FRACTION  # (the verdict's fraction, in the help)
+
 NAME = "identify"
 HELP = "identify zero offsets and MAEMM from a measurement file (Ipopt or TSVD)"
 
 
 #: the files ``--plot DIR`` writes into DIR
 PLOTS = ("residuals.png", "boundary_errors.png")
-#: without --goal-deg, the offsets' 1 sigma is small when at most this fraction of the largest |offset|
-SIGMA_FRACTION = 0.1
-#: identify's options that change only what is written, not the result nor the verdict: not in the next command
-_OUTPUT_ONLY = ("json", "out", "plot", "report")
 
 
 def add_arguments(p):
@@ -45,8 +48,13 @@ def add_arguments(p):
     p.add_argument("--method", choices=["nlls", "tsvd"], default="nlls", help="identification method (default nlls)")
     p.add_argument("--params", default="paper",
                    help="nlls parameter set: paper (the zero offsets and the MAEMM, e.g. theta1 theta2 rMx rMy) "
-                        "| all | gauge_fixed | names joined by , or + (e.g. paper+L1,L2); tsvd always identifies "
-                        "the paper's set")
+                        "| all | gauge_fixed | names joined by , or + (e.g. paper+L1,L2) | auto (of paper plus "
+                        "whole groups of robot-file entries, the set whose offsets' expected error at these poses "
+                        "is least: docs/trust.md); tsvd always identifies the paper's set")
+    p.add_argument("--test-groups", action="store_true",
+                   help="free each group of robot-file entries in turn (L for L1 L2 L3; nlls fits with and without "
+                        "it) and name those the data contradict (likelihood ratio, p < --fit-alpha); done anyway "
+                        "when an nlls fit is rejected without a detected cause")
     p.add_argument("--noise", choices=["paper", "scale-only", "servo-only", "none"], default="paper",
                    help="noise model for the weights and the covariance (default paper; none: unit weights, "
                         "covariance from the residuals)")
@@ -68,8 +76,9 @@ def add_arguments(p):
                         "steps (20 without N); default one step, the paper's")
     p.add_argument("--report", action="store_true", help="also print the identifiability report (text output)")
     p.add_argument("--tolerance", action="append", default=[], metavar="NAME=VALUE",
-                   help="tolerance of a source error left out of the identification (mm; deg for angles), for the "
-                        "bias the estimate may carry (default: the mechanism's, docs/design.md); repeatable")
+                   help="tolerance of a source error left out of the identification, or of a group of them (L "
+                        "for L1 L2 L3) (mm; deg for angles), for the error budget; repeatable (default: the robot "
+                        "file's [tolerances], else a robot measured by hand: docs/trust.md)")
     p.add_argument("--tolerance-file", default=None, metavar="FILE", type=InputFile("the tolerance file"),
                    help="tolerances by name (TOML or JSON)")
     p.add_argument("--tolerance-scale", type=float, default=1.0, metavar="S", help="every tolerance times S")
@@ -79,6 +88,9 @@ def add_arguments(p):
                         f"{SIGMA_FRACTION:g} x the largest |offset|)")
     p.add_argument("--goal-deg", type=float, default=None, metavar="DEG",
                    help="the same for revolute joints, in deg")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "the measurement file")
     p.add_argument("--json", action="store_true", help="print the results JSON")
     p.add_argument("--out", metavar="FILE.json", default=None, type=OutputFile(), help="write the results JSON here")
     p.add_argument("--plot", metavar="DIR", default=None, type=OutputDir(PLOTS),
@@ -142,32 +154,6 @@ def diagnosis(res) -> str:
     """The fit check's paragraph of a result ('' when there is none)."""
     fit = res.info.get("fit") if isinstance(res.info, dict) else None
     return (fit or {}).get("diagnosis") or ""
-
-
-def offsets_sigma_text(res, goal=None) -> str:
-    """The offsets' 1 sigma and whether it is small: against ``goal`` (``--goal``, in the offsets' unit: deg or
-    mm; ``--goal-deg`` for revolute joints) when given, else against the offsets' scale, the largest |offset|
-    (one scale for all: an offset near zero is no reason to measure more)."""
-    import numpy as np
-
-    off = np.abs(np.asarray(res.zero_offsets_user, float))
-    std = np.asarray(res.std_zero_offsets_user, float)
-    if not np.all(np.isfinite(std)):
-        return "offsets' 1 sigma not available"
-    s = ", ".join(f"{x:.3g}" for x in std)
-    kind = f" ({res.std_kind})" if getattr(res, "std_kind", None) else ""
-    worst = float(np.max(std))
-    u = getattr(res, "offset_unit", "deg")
-    if goal is not None:
-        verdict = (f"within the goal {goal:g} {u}" if worst <= goal else
-                   f"NOT within the goal {goal:g} {u}; measure more poses")
-    else:
-        scale = float(np.max(off)) if off.size else 0.0
-        verdict = (f"small against the offsets (<= {SIGMA_FRACTION:g} x the largest |offset|, {scale:.3g} {u})"
-                   if worst <= SIGMA_FRACTION * scale else
-                   f"NOT small against the offsets (> {SIGMA_FRACTION:g} x the largest |offset|, {scale:.3g} {u}); "
-                   "measure more poses, or state the accuracy you need with --goal")
-    return f"offsets' 1 sigma {s} {u}{kind}: {verdict}"
 
 
 def _parse_named(items, robot, names, what, parse):
@@ -241,24 +227,6 @@ def result_json(robot, meas, res, report, source, accept_misfit=False) -> dict:
     return json_safe(d)
 
 
-def print_estimate(robot, res) -> None:
-    """The identified parameters with their std (user units) and the compensation, as text."""
-    import numpy as np
-
-    from zerocal_sym.io.results import sign_convention
-
-    errors = robot.errors
-    for n, v in zip(res.params, res.estimate):
-        s = res.std(n)
-        std = f" ± {errors.to_user_value(n, s):.4g}" if np.isfinite(s) else ""
-        print(f"  {n:7s} = {errors.to_user_value(n, v):+.6f}{std} {errors[n].user_unit}")
-    print(f"compensation ({sign_convention(res.offset_unit)}):")
-    for j, n in enumerate(robot.mechanism.joint_names):
-        s = res.std_zero_offsets_user[j]
-        print(f"  {n}: offset {res.zero_offsets_user[j]:+.6f} {res.offset_unit}"
-              + (f" (std {s:.4g})" if np.isfinite(s) else ""))
-
-
 def run(args):
     import contextlib
     import sys
@@ -266,6 +234,8 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
+    from zerocal_sym.cli._identify_text import (print_budget, print_choice, print_estimate, print_group_test,
+                                                verdict_line)
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.identify.identifiability import format_report, identifiability_report
     from zerocal_sym.io.files import staged_directory, to_json, write_json
@@ -275,16 +245,23 @@ def run(args):
     robot = load_robot_arg(args)
     errors = robot.errors
     prior = maemm_prior_vector(robot, args.maemm_prior)
-    meas = load_measurements(args.data, robot)  # refuses data of another mechanism or robot (robot_sha256)
+    meas = load_measurements(args.data, robot, allow_revisits=args.allow_revisits)  # refuses data of another mechanism or robot (robot_sha256)
     noise = NoiseModel.named(args.noise, robot)
+    if args.loss not in (None, "l2") and noise.has_shared:
+        raise ZerocalError(f"--loss {args.loss}: a robust loss does not take the robot file's shared revisit error "
+                           f"([noise] revisit_std_mm = {noise.sigma_revisit_mm:g}): use --loss l2, or --noise "
+                           "scale-only / servo-only")
     from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
 
+    auto = args.params == "auto"
     try:  # the tolerances of the errors left out, checked before any work
-        tol_params = errors.resolve("offsets+measuring" if args.method == "tsvd" else args.params)
+        tol_params = errors.resolve("offsets+measuring" if args.method == "tsvd" else
+                                    "paper" if auto else args.params)
     except ValueError:
         tol_params = None  # a bad --params is reported below, with its own message
     tol = (make_tolerances(robot, args.tolerance, args.tolerance_file, args.tolerance_scale, params=tol_params)
            if tol_params is not None else None)
+    choice = None
     if args.method == "tsvd":
         if args.params != "paper" or args.prior_std or args.bound or args.max_iter is not None:
             raise ZerocalError("--params, --prior-std, --bound and --max-iter are for --method nlls "
@@ -306,10 +283,16 @@ def run(args):
     else:
         if args.truncation is not None or args.rule is not None or args.iterate is not None:
             raise ZerocalError("--truncation, --rule and --iterate are for --method tsvd")
-        try:
-            names = errors.resolve(args.params)
-        except ValueError as exc:
-            raise ZerocalError(f"--params: {exc}") from None
+        if auto:  # the set whose offsets' expected error at these poses is least
+            from zerocal_sym.identify.choose import choose_params
+
+            choice = choose_params(robot, meas.theta_cmd, tol, noise if not noise.is_zero else None, "paper", prior)
+            names = errors.resolve(choice["chosen"])
+        else:
+            try:
+                names = errors.resolve(args.params)
+            except ValueError as exc:
+                raise ZerocalError(f"--params: {exc}") from None
         if meas.K - 1 < len(names):
             raise ZerocalError(f"{meas.K} poses give {meas.K - 1} measured changes: fewer than the {len(names)} "
                                f"parameters {', '.join(names)}", where=args.data)
@@ -350,6 +333,7 @@ def run(args):
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
     bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=err0)
     out["bias"] = bias
+    out.update(budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol))
     if not res.success:
         if args.json:
             print(to_json(out))
@@ -359,9 +343,13 @@ def run(args):
         print(f"zerocal identify: {why} ({res.method}): {res.status}; no calibration written", file=sys.stderr)
         if diagnosis(res):
             print(diagnosis(res), file=sys.stderr)
+        test = out.get("robot_file_test")
+        if test and not args.json:
+            print_group_test(test)
         if not args.json:
             status = res.status.removeprefix("rejected: ")  # the status of a rejected fit starts so already
-            print(f"verdict: rejected: {status}; next: see the diagnosis above, fix the data or the robot file "
+            said = f"; {test['summary']}" if test and test["contradicted"] else ""
+            print(f"verdict: rejected: {status}{said}; next: see the diagnosis above, fix the data or the robot file "
                   "and identify again")
         return 1
     from zerocal_sym.identify.fitcheck import plausibility
@@ -393,21 +381,53 @@ def run(args):
         return 0
     print(f"{args.data}: K = {meas.K} poses, robot {robot.name} ({robot.mechanism_name}), method {res.method}: "
           f"{res.status}")
+    if choice:
+        print_choice(choice)
     print_estimate(robot, res)
-    zo = bias["zero_offsets"]
-    print("bias the offsets may carry from the errors left out (first order, their tolerances): worst case "
-          + ", ".join(f"{v:.4g}" for v in zo["worst_case_" + zo["unit"]]) + f" {zo['unit']}, RMS "
-          + ", ".join(f"{v:.4g}" for v in zo["rms_" + zo["unit"]]) + f" {zo['unit']} (--tolerance NAME=VALUE to change)")
+    print_budget(out)
+    if out.get("robot_file_test"):
+        print_group_test(out["robot_file_test"])
     info = res.info
     if res.method == "nlls":
         print(f"Ipopt: {info['solver_status']}, {info['iterations']} iterations, cost {info['cost']:.6g}, "
               f"chi2 {info['chi2']:.4g} on {info['dof']} dof; weights: {info['weighting']}")
+    if "revisits" in info:
+        from zerocal_sym.identify.revisits import describe
+
+        print(describe(info["revisits"]))
     if args.report:
         print(format_report(report))
     if args.out:
         print(f"wrote {args.out}")
-    print(verdict_line(res, args))
+    print(verdict_line(res, args, out.get("remedy"), meas.K))
     return 0
+
+
+def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol) -> dict:
+    """The results JSON's ``error_budget``, ``limited_by``, ``remedy``, and ``params_choice`` (``--params auto``)
+    and ``robot_file_test`` (``--test-groups``, or an nlls fit rejected without a detected cause)."""
+    from zerocal_sym.identify import budget as bg
+
+    b = bg.error_budget(bias, res)
+    spec = choice["chosen"] if choice else ("paper" if res.method == "tsvd" else args.params)
+    out = {"error_budget": b["error_budget"], "limited_by": b["limited_by"],
+           "remedy": bg.remedy(b["error_budget"], robot, spec)}
+    if choice:
+        out["params_choice"] = choice
+    fit = res.info.get("fit") or {}
+    unexplained = (res.method == "nlls" and fit.get("rejected") and not any(c.get("detected") for c in
+                                                                            fit.get("causes", []))
+                   and (args.loss in (None, "l2")) and not args.bound and not args.prior_std)
+    if getattr(args, "test_groups", False) or unexplained:
+        from zerocal_sym.identify.freeing import free_each_group
+
+        out["robot_file_test"] = free_each_group(robot, meas, spec, noise=noise, prior=prior, alpha=args.fit_alpha,
+                                                 tolerances=tol,
+                                                 held=res if res.method == "nlls" and not args.bound
+                                                 and not args.prior_std and args.loss in (None, "l2") else None)
+    from zerocal_sym.io.files import json_safe
+
+    return json_safe(out)
 
 
 def evaluation_point(robot, meas, res, prior):
@@ -424,56 +444,3 @@ def evaluation_point(robot, meas, res, prior):
     with np.errstate(all="ignore"):
         rho, de, dt = kin.distance_jacobians(robot, meas.theta_cmd, err)
     return err if all(np.all(np.isfinite(a)) for a in (rho, de, dt)) else prior
-
-
-def verdict_line(res, args) -> str:
-    """The one line a person acts on: accepted / why, the offsets' 1 sigma, the next command."""
-    fit = res.info.get("fit") or {}
-    p = fit.get("p_value")
-    if fit.get("accepted_despite_misfit"):
-        why = f"accepted despite misfit (--accept-misfit; fit p-value {p:.3g} < {fit.get('alpha', args.fit_alpha):g})"
-    elif fit.get("checked") and p is not None:
-        why = f"accepted: fit p-value {p:.3g} >= {fit.get('alpha', args.fit_alpha):g}"
-    else:
-        why = f"accepted: fit not checked ({fit.get('reason') or 'no spare degree of freedom'})"
-    robot = ["--robot", args.robot] if getattr(args, "robot", None) else []
-    compensate = _command("compensate", args.out or "RESULT.json", *robot, "--out", "table.csv")
-    nxt = (compensate if args.out else
-           f"{_command('identify', *repeat_options(args), '--out', 'RESULT.json')}, then {compensate}")
-    goal = getattr(args, "goal", None)
-    goal = goal if goal is not None else getattr(args, "goal_deg", None)
-    return f"verdict: {why}; {offsets_sigma_text(res, goal)}; next: {nxt}"
-
-
-def _command(*words) -> str:
-    import shlex
-
-    return "zerocal " + " ".join(shlex.quote(str(w)) for w in words)
-
-
-def repeat_options(args) -> list:
-    """The data file and every option given but the output ones (:data:`_OUTPUT_ONLY`): ``--robot``,
-    ``--method``, ``--noise``, priors, bounds, tolerances, the fit check's, ``--goal-deg``, as words (floats as
-    Python writes them, digit for digit): ``identify`` with them repeats this run."""
-    import argparse
-
-    from zerocal_sym.cli import build_parser
-    from zerocal_sym.cli._checks import _given
-
-    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices[NAME]
-    words = [args.data]
-    for a in sub._actions:
-        if (not a.option_strings or a.dest in _OUTPUT_ONLY or a.default is argparse.SUPPRESS
-                or not _given(args, a.dest)):
-            continue
-        value, opt = getattr(args, a.dest), a.option_strings[0]
-        if a.nargs == 0:  # a flag
-            words.append(opt)
-        elif isinstance(a, argparse._AppendAction):
-            for v in value:
-                words += [opt, v]
-        elif isinstance(value, (list, tuple)):
-            words += [opt, *value]
-        else:
-            words += [opt, value]
-    return [str(w) for w in words]

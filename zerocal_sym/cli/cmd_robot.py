@@ -70,6 +70,7 @@ def run(args):
           f"{pose_text(s['min_transmission_sine_at' + pk], '.6g')} (required >= {s['singularity_margin']:g})")
     noise = robot.noise
     print(f"noise: scale {noise.sigma_scale_mm:g} mm per change, joints "
-          f"{float(units.joints_to_user(robot, noise.sigma_joint)):.4g} {ju} per joint per pose")
+          f"{float(units.joints_to_user(robot, noise.sigma_joint)):.4g} {ju} per joint per pose"
+          + (f", {noise.sigma_revisit_mm:g} mm per pose shared by its revisits" if noise.has_shared else ""))
     print(f"sha256: {s['sha256']}")
     return 0

@@ -64,6 +64,9 @@ def add_arguments(p):
     _parallel.add_arguments(p, "the identifications")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no account of the chunks")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    from zerocal_sym.cli._common import add_revisits_argument
+
+    add_revisits_argument(p, "a pose file of the spec")
 
 
 class _LineEnd:
@@ -116,7 +119,7 @@ def run(args):
             raise ZerocalError(f"{', '.join(bad)}: where the study runs (--out DIR); --summary only reads the chunk "
                                "files on disk")
     mode()  # ZEROCAL_COMPILE: a bogus value is a user error before anything is read or written
-    spec = load_spec(args.spec)
+    spec = load_spec(args.spec, getattr(args, "allow_revisits", False))
     if args.out is not None:  # the files the spec names are inputs too (the spec itself: cli/_checks.py)
         from zerocal_sym.io.files import check_outputs
 

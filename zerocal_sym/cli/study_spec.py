@@ -270,7 +270,7 @@ def _filter(tab, labels, where_key):
     return set(f)
 
 
-def _design_poses(tab, robot, base, wk):
+def _design_poses(tab, robot, base, wk, allow_revisits=False):
     """(label, poses) of one [[design]] table for one robot."""
     from zerocal_sym.cli._common import check_scheme, scheme_poses
     from zerocal_sym.io.poses import load_poses
@@ -278,7 +278,7 @@ def _design_poses(tab, robot, base, wk):
     if "poses" in tab:
         p = Path(tab["poses"]) if Path(tab["poses"]).is_absolute() else base / tab["poses"]
         try:
-            P = load_poses(p, robot)
+            P = load_poses(p, robot, allow_revisits, measured=True)
         except ZerocalError as exc:
             raise StudySpecError(f"poses for robot {robot.name!r}: {exc}", where=wk("poses")) from None
         return tab.get("label") or f"poses-{_slug(p.stem)}", P
@@ -302,7 +302,7 @@ def _first_unassembled(robot, theta, err):
     return int(np.flatnonzero(bad)[0]) if bad.any() else None
 
 
-def load_spec(path) -> Study:
+def load_spec(path, allow_revisits: bool = False) -> Study:
     """Read and validate a study spec (TOML); every cell is built (robots loaded, poses checked).
 
     Raises
@@ -389,7 +389,7 @@ def load_spec(path) -> Study:
             flt = _filter(dt, labels, wd)
             if flt is not None and rl not in flt:
                 continue
-            dlabel, P = _design_poses(dt, robot, base, wd)
+            dlabel, P = _design_poses(dt, robot, base, wd, allow_revisits)
             try:
                 theta = kin.check_poses(robot, P)
             except ZerocalError as exc:
@@ -455,7 +455,12 @@ def load_spec(path) -> Study:
         raise StudySpecError("no cell: every [[design]] or [[truth]] is filtered out for every robot",
                              where=str(path))
     check_spec(study, where, StudySpecError)  # what this machine can hold: chunk files, memory
-    study.inputs = ([("a robot file of the spec", base / r) for r in raw["robots"] if r != "paper"]
+    from zerocal_sym.model.robot import module_file
+
+    robot_files = [base / r for r in raw["robots"] if r != "paper"]
+    study.inputs = ([("a robot file of the spec", f) for f in robot_files]
+                    + [("the mechanism module of a robot file of the spec", m) for m in map(module_file, robot_files)
+                       if m is not None]
                     + [("a pose file of the spec", base / dt["poses"]) for dt in designs if "poses" in dt])
     return study
 

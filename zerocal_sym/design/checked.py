@@ -212,7 +212,7 @@ def checked_search(robot, K, cons: Constraints, noise, req: Requirement, starts,
 
 
 def checked_design(robot, K, cons, noise, seed, n_starts, exchange_starts, grid, tolerances, method, certificate,
-                   requirement: Requirement | None = None):
+                   requirement: Requirement | None = None, progress=None):
     """:func:`zerocal_sym.design.optimize.optimize_design` for ``criterion="checked"``.
 
     The crlb-optimal design first (the same path, the reference of the trade-off); if its fit check already
@@ -236,7 +236,8 @@ def checked_design(robot, K, cons, noise, seed, n_starts, exchange_starts, grid,
     t0 = time.perf_counter()
     req = requirement or Requirement(robot, tolerances)
     ref = optimize_design(robot, K, "crlb", cons, noise, seed, n_starts, exchange_starts, grid,
-                          tolerances=tolerances, method=method, certificate=certificate, requirement=req)
+                          tolerances=tolerances, method=method, certificate=certificate, requirement=req,
+                          progress=progress)
     req.count_harm_in(robot, ref.poses, noise, "the crlb-optimal design's")
     ref.report = evaluate(robot, ref.poses, "crlb", noise, cons, tolerances, req)
     if ref.baseline_poses is not None:

@@ -22,8 +22,10 @@ Constraints
   file unit (deg for revolute joints, mm for prismatic ones), one
   ``(lo, hi)`` per joint, shape (m, 2);
 * distinct poses: pairwise distance at least ``min_separation_mm`` (default
-  1 mm; the data loader rejects repeated poses); for a pose with orientations
-  a degree counts as a millimetre (:func:`zerocal_sym.design.terms.pose_distances`).
+  1 mm) between distinct poses; a pose may be visited again (a *replicate*,
+  equal to :data:`~zerocal_sym.model.revisits.REVISIT_TOL`), never twice in a
+  row (a zero change); for a pose with orientations a degree counts as a
+  millimetre (:func:`zerocal_sym.design.terms.pose_distances`).
 
 This module holds :class:`Constraints`, :func:`make_constraints` and the
 feasibility checks (:func:`check_design`, per pose, of the travel); the
@@ -276,13 +278,22 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
         d = np.abs(np.diff(rho))
         for k in np.flatnonzero(d > cons.travel_mm + tol):
             out.append(f"scale travel: |rho_{k + 1} - rho_{k}| = {d[k]:.3f} mm > l0 = {cons.travel_mm:g} mm")
-    if cons.min_separation_mm > 0 and len(P) > 1:
-        dist = pose_distances(robot, P)
-        iu = np.triu_indices(len(P), 1)
-        close = np.flatnonzero(dist[iu] < cons.min_separation_mm - tol)
-        for c in close:
-            out.append(f"poses {iu[0][c]} and {iu[1][c]} are {dist[iu][c]:.3f} mm apart "
-                       f"< {cons.min_separation_mm:g} mm")
+    if len(P) > 1:
+        from zerocal_sym.model.revisits import REVISIT_TOL, consecutive_repeat, pose_groups
+
+        U = poses_to_user(robot, P)
+        k = consecutive_repeat(U, REVISIT_TOL)
+        if k is not None:
+            out.append(f"pose {k} repeats pose {k - 1} (a zero change: no information)")
+        if cons.min_separation_mm > 0:  # between distinct poses (a replicate is the same pose again)
+            lab = pose_groups(U, REVISIT_TOL)
+            first = np.unique(lab, return_index=True)[1]
+            dist = pose_distances(robot, P[first])
+            iu = np.triu_indices(len(first), 1)
+            close = np.flatnonzero(dist[iu] < cons.min_separation_mm - tol)
+            for c in close:
+                out.append(f"poses {first[iu[0][c]]} and {first[iu[1][c]]} are {dist[iu][c]:.3f} mm apart "
+                           f"< {cons.min_separation_mm:g} mm")
     return out
 
 

@@ -66,6 +66,7 @@ from zerocal_sym.model import units
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import DesignError
 from zerocal_sym.design.constraints import Constraints, check_design
+from zerocal_sym.design.replicates import revisit_terms
 from zerocal_sym.design.terms import (Weights, _crlb_weights, _qscale, design_params, noise_dict, offset_unit,
                                       offsets_to_user, okey, pose_terms, pose_units, poses_to_user)
 
@@ -175,14 +176,19 @@ def _fisher_banded(aq, v, sm2):
 BANDED_K = 60
 
 
-def _fisher(aq, v, sm2):
-    """:func:`_fisher_batch`, banded for one design with K >= :data:`BANDED_K`."""
+def _fisher(aq, v, sm2, shared=None):
+    """:func:`_fisher_batch`, banded for one design with K >= :data:`BANDED_K`; with ``shared`` (the revisited
+    poses' part of one design, :func:`zerocal_sym.design.replicates.revisit_terms`) exact with it."""
+    if shared is not None:
+        from zerocal_sym.design.replicates import shared_fisher
+
+        return shared_fisher(aq[0], v[0], sm2, shared)[None]
     if aq.shape[0] == 1 and aq.shape[1] >= BANDED_K:
         return _fisher_banded(aq[0], v[0], sm2)[None]
     return _fisher_batch(aq, v, sm2)
 
 
-def _objective_batch(criterion, aq, v, sm2, w):
+def _objective_batch(criterion, aq, v, sm2, w, shared=None):
     """Internal objective (smaller is better; ``inf`` for rank-deficient designs), shape (B,).
 
     Parameters
@@ -197,6 +203,8 @@ def _objective_batch(criterion, aq, v, sm2, w):
         its objective is ``log sum_j w_j [F_q^-1]_jj``, the log of the mean
         variance of the zero offsets (rad^2); a :class:`Weights` for every
         criterion (``position`` and ``mse`` need one).
+    shared : ndarray, shape (K-1, G), optional
+        The revisited poses' shared error of one design (:func:`_fisher`).
     """
     B = aq.shape[0]
     out = np.full(B, np.inf)
@@ -206,7 +214,7 @@ def _objective_batch(criterion, aq, v, sm2, w):
         ok = s[:, -1] > 1e-12 * s[:, 0]
         out[ok] = np.log(s[ok, 0] / s[ok, -1])
         return out
-    return _objective_fisher(criterion, _fisher(aq, v, sm2), w)
+    return _objective_fisher(criterion, _fisher(aq, v, sm2, shared), w)
 
 
 def _objective_fisher(criterion, F, w):
@@ -275,12 +283,13 @@ def criterion_values(robot, P, noise: NoiseModel | None = None, tolerances=None)
     w = _crlb_weights(robot)
     wt = Weights(robot, tolerances)
     aq, v, ao = _terms_batch(robot, P, noise, omitted=True)
+    v, B = revisit_terms(robot, P, noise, v)
     res = {}
     for c in CRITERIA:
         if c in EXTENDED:
-            o = float(_objective_batch(c, wt.extend(aq, ao), v, sm2, wt)[0])
+            o = float(_objective_batch(c, wt.extend(aq, ao), v, sm2, wt, B)[0])
         else:
-            o = float(_objective_batch(c, aq, v, sm2, wt if c == "position" else w)[0])
+            o = float(_objective_batch(c, aq, v, sm2, wt if c == "position" else w, B)[0])
         res[c] = _user_value(c, o, robot.errors.offset_unit)
     return res
 
@@ -347,7 +356,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     vals = criterion_values(robot, P, noise, tolerances)
     t = pose_terms(robot, P)
     try:
-        crlb = fisher.crlb_zero_offsets_user(robot, t["theta"], "paper", noise).tolist()
+        crlb = fisher.crlb_zero_offsets_user(robot, t["theta"], design_params(robot), noise).tolist()
     except PoseError:
         crlb = [math.inf] * robot.m
     bias_rep = _bias_report(robot, t["theta"], noise, tolerances, crlb)
@@ -393,7 +402,7 @@ def _bias_report(robot, theta, noise, tolerances, crlb):
     from zerocal_sym.identify import bias
 
     try:
-        b = bias.tolerance_bias(robot, theta, tolerances, "paper", noise)
+        b = bias.tolerance_bias(robot, theta, tolerances, design_params(robot), noise)
     except (np.linalg.LinAlgError, ValueError):
         return None
     off = [b["params"].index(z) for z in robot.errors.zero_offsets]
@@ -427,7 +436,8 @@ def position_report(robot, P, noise=None) -> dict:
     P = np.atleast_2d(np.asarray(P, float))
     sm2, _ = _noise_terms(noise, robot)
     aq, v = _terms_batch(robot, P, noise)
-    F = _fisher(aq, v, sm2)[0]
+    v, B = revisit_terms(robot, P, noise, v)
+    F = _fisher(aq, v, sm2, B)[0]
     grid, J = position_jacobians(robot)
     try:
         Fi = np.linalg.inv(F)
@@ -477,6 +487,8 @@ def _objective(robot, criterion, P, noise, tolerances=None):
         aq, v, ao = _terms_batch(robot, P, noise, omitted=True)
         if criterion in EXTENDED:
             aq = wt.extend(aq, ao)
-        return float(_objective_batch(criterion, aq, v, _noise_terms(noise, robot)[0], wt)[0])
-    return float(_objective_batch(criterion, *_terms_batch(robot, P, noise), _noise_terms(noise, robot)[0],
-                                  _crlb_weights(robot))[0])
+        v, B = revisit_terms(robot, P, noise, v)
+        return float(_objective_batch(criterion, aq, v, _noise_terms(noise, robot)[0], wt, B)[0])
+    aq, v = _terms_batch(robot, P, noise)
+    v, B = revisit_terms(robot, P, noise, v)
+    return float(_objective_batch(criterion, aq, v, _noise_terms(noise, robot)[0], _crlb_weights(robot), B)[0])

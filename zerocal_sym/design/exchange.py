@@ -30,7 +30,8 @@ def candidate_grid(robot, cons: Constraints, *grid):
 
 
 def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                    n_starts: int = 8, grid=None, max_sweeps: int = 50, tolerances=None, objective=None):
+                    n_starts: int = 8, grid=None, max_sweeps: int = 50, tolerances=None, step=None,
+                    objective=None):
     """Discrete coordinate exchange over a candidate grid.
 
     Each start is a random ordered set of K distinct feasible candidates
@@ -46,6 +47,8 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         cylinder).
     tolerances : dict, optional
         Tolerances of the omitted errors (``mse``).
+    step : callable, optional
+        ``step()`` after each start (progress).
     objective : callable, optional
         ``objective(candidates)`` returns a function of index sets (B, K) into the candidates (N, n) giving
         B internal objectives (smaller is better): used instead of the criterion's (the checked design,
@@ -111,6 +114,8 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
             if not improved:
                 break
         starts.append(float(cur))
+        if step is not None:
+            step()
         if cur < best_o:
             best_idx, best_o = idx.copy(), cur
     if not np.isfinite(best_o):

@@ -36,6 +36,10 @@ def fewest_poses(robot, target: float, cons: Constraints | None = None, noise=No
     falls as ``1/sqrt(K)``: a step to the predicted K, then bisection), and
     the smallest K whose design meets the target is returned with its poses.
 
+    With a shared revisit error (``noise.sigma_revisit_mm``) the CRLB of the
+    replicates levels off (:func:`zerocal_sym.design.replicates.shared_floor`):
+    a target below that floor is refused at once.
+
     Returns
     -------
     dict
@@ -72,6 +76,13 @@ def fewest_poses(robot, target: float, cons: Constraints | None = None, noise=No
     if k_lb > k_max:
         raise DesignError(f"a CRLB of {target:g} {u} needs at least {k_lb} poses (certified), more than "
                           f"the {k_max} allowed")
+    from zerocal_sym.design.replicates import shared_floor
+
+    floor = shared_floor(robot, ad.support, noise)
+    if floor >= target:  # the shared revisit error: replicates level off above the target
+        raise DesignError(f"a CRLB of {target:g} {u} is out of reach of this design's replicates: the shared "
+                          f"revisit error ({noise.sigma_revisit_mm:g} mm per pose) keeps their CRLB above "
+                          f"{floor:.4g} {u} however many poses (more support points, or a smaller revisit_std_mm)")
     evaluated = {}
     designs = {}
 

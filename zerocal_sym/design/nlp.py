@@ -43,7 +43,7 @@ from zerocal_sym.design.constraints import (Constraints, _feasible_random_subset
                                             make_constraints)
 from zerocal_sym.design.criteria import (EXTENDED, _check_criterion, _criterion_weights, _fisher_batch,
                                          _noise_terms, _objective, _objective_batch, _terms_batch, _user_value)
-from zerocal_sym.design.terms import (Weights, _crlb_weights, _pose_terms_fn, _qscale, _user_scale, pose_distances,
+from zerocal_sym.design.terms import (Weights, _crlb_weights, _qscale, pose_terms_fn, _user_scale, pose_distances,
                                       pose_terms)
 
 #: formulation of the matrix inequalities per criterion for p <= 4 (measured best, see module docstring)
@@ -82,7 +82,7 @@ def nlp_form(robot) -> str:
     16-corner fraction, the exact Hessian took 229 s to build and 62 s to solve, L-BFGS 58 s and 10 s, and
     reached a lower CRLB (0.03693 against 0.03756 mm): ``python benchmarks/bench_design_hexapod.py --parts
     form`` (docs/design.md)."""
-    return "large" if _pose_terms_fn(robot.mechanism_name).n_nodes() > LARGE_TERMS_NODES else "exact"
+    return "large" if pose_terms_fn(robot).n_nodes() > LARGE_TERMS_NODES else "exact"
 
 
 class _NLP:
@@ -109,7 +109,7 @@ class _NLP:
         c, h = region.center, region.half
         z = X.sym("z", dim, K)
         P = ca.repmat(ca.DM(c), 1, K) + ca.repmat(ca.DM(h), 1, K) * z
-        f = _pose_terms_fn(robot.mechanism_name).map(K)
+        f = pose_terms_fn(robot).map(K)
         theta, ratio, s, rho, a, dth, ao = f(P, robot.geometry)
         aq = ca.repmat(ca.DM(qs), 1, K) * a
         v = sx2 * ca.sum1(dth ** 2)
@@ -353,7 +353,7 @@ def _scales(robot, P, noise):
 
 
 def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                      n_starts: int = 8, starts=None, max_iter: int = 500, tolerances=None):
+                      n_starts: int = 8, starts=None, max_iter: int = 500, tolerances=None, step=None):
     """Multi-start Ipopt over the K poses.
 
     Parameters
@@ -372,6 +372,8 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         Extra starts (e.g. the boundary scheme, an exchange design).
     tolerances : dict, optional
         Tolerances of the omitted errors (``mse``).
+    step : callable, optional
+        ``step()`` after each Ipopt start (progress).
 
     Returns
     -------
@@ -407,6 +409,8 @@ def continuous_design(robot, K, criterion="crlb", cons: Constraints | None = Non
         runs.append({"start": label, "value": _user_value(criterion, o, robot.errors.offset_unit), "status": status,
                      "iterations": iters,
                      "feasible": not viol, "time_s": time.perf_counter() - ts})
+        if step is not None:
+            step()
         if not viol and np.isfinite(o) and (best is None or o < best[1]):
             best = (P, o)
     if best is None:

@@ -46,7 +46,7 @@ from zerocal_sym.design.criteria import CHECKED, DESIGN_CRITERIA, _check_criteri
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
-from zerocal_sym.design.terms import describe_noise, noise_dict, poses_to_user
+from zerocal_sym.design.terms import describe_noise, design_params, noise_dict, poses_to_user
 
 
 # --------------------------------------------------------------------------- baseline
@@ -255,6 +255,9 @@ class DesignResult:
             "continuous": {k: v for k, v in self.continuous.items() if k in ("value", "runs", "time_s", "build_s")},
             "timing_s": self.timing,
         })
+        from zerocal_sym.design.replicates import revisits_entry
+
+        rep.update(revisits_entry(self.poses))  # a pose file of the design accepts its replicates
         if self.checked is not None:
             rep["checked"] = self.checked
         return rep
@@ -311,7 +314,8 @@ def _certificate(ad, criterion, value, K, design_value_crlb=None, robot=None, P=
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
                     exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None,
-                    method: str = "auto", certificate: bool = True, requirement=None) -> DesignResult:
+                    method: str = "auto", certificate: bool = True, progress=None,
+                    requirement=None) -> DesignResult:
     """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
     Two paths (``method``):
@@ -329,7 +333,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
       hundreds.  ``mse``: the measure is improved locally for the bias
       (:func:`zerocal_sym.design.mse.mse_measure`); ``cond``: exact only.
     * ``auto`` (default) -- ``exact`` for K <= :data:`EXACT_MAX_K` (and for
-      ``cond``), ``approx`` beyond.
+      ``cond``), ``approx`` beyond; ``approx`` at any K for a robot that
+      identifies more than its mechanism's default set
+      (``robot.identifying("paper+L1,L2,L3")``): there the exact path's
+      local search ends at designs that identify the offsets at zero errors
+      only, leaving the extra entries nearly free (the rotary Delta with its
+      upper arms freed: ``python examples/delta_arms.py``, docs/trust.md);
+      the design measure's support does not.
 
     With ``certificate`` the approximate design of the criterion (of crlb for
     mse) also gives the bound on what any K-pose design on the candidates
@@ -358,6 +368,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         default :func:`zerocal_sym.identify.bias.default_tolerances`).
     method : {"auto", "exact", "approx"}
     certificate : bool
+    progress : callable, optional
+        ``progress(done, total)`` after each step (the approximate design, each exchange and Ipopt start, each
+        polish); ``done == total`` at the end.
     requirement : zerocal_sym.design.detection.Requirement, optional
         What a ``checked`` design must see (default: its defaults with ``tolerances``).
 
@@ -375,11 +388,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         from zerocal_sym.design.checked import checked_design
 
         return checked_design(robot, K, cons or make_constraints(robot), NoiseModel.coerce(noise, robot=robot),
-                              seed, n_starts, exchange_starts, grid, tolerances, method, certificate, requirement)
+                              seed, n_starts, exchange_starts, grid, tolerances, method, certificate, requirement,
+                              progress)
     if method not in METHODS:
         raise DesignError(f"unknown design method {method!r} (known: {', '.join(METHODS)})")
     if method == "auto":
-        method = "exact" if K <= EXACT_MAX_K or criterion == "cond" else "approx"
+        default_set = set(design_params(robot)) == set(robot.errors.resolve("paper"))
+        method = "exact" if (K <= EXACT_MAX_K and default_set) or criterion == "cond" else "approx"
     if method == "approx" and criterion == "cond":
         raise DesignError("the condition number has no approximate design (it is not concave): use the exact "
                           f"method (K <= {MAX_K_EXACT})")
@@ -393,10 +408,21 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     t0 = time.perf_counter()
     ad = None
     mcrit = "crlb" if criterion == "mse" else criterion
-    if method == "approx" or (certificate and criterion != "cond"):
+    base, base_label, base_note, rejected = choose_baseline(robot, K, cons)
+    with_ad = method == "approx" or (certificate and criterion != "cond")
+    total = int(with_ad) + ((criterion == "mse") + 1 if method == "approx" else
+                            exchange_starts + n_starts + (base is not None) + 2)
+    done = [0]
+
+    def step():
+        done[0] = min(done[0] + 1, total)
+        if progress is not None:
+            progress(done[0], total)
+
+    if with_ad:
         ad = approximate_design(robot, mcrit, cons, noise, tolerances=tolerances)
         timing["approximate"] = time.perf_counter() - t0
-    base, base_label, base_note, rejected = choose_baseline(robot, K, cons)
+        step()
     scheme = robot.workspace.scheme_name
     ex, cont, approx_info = {}, {}, None
     if method == "approx":
@@ -404,7 +430,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         mad = ad
         if criterion == "mse":
             mad = mse_measure(robot, ad, K, cons, noise, tolerances)
+            step()
         P, info = realize(robot, mad, K, cons, noise, tolerances, criterion)
+        step()
         timing["round_order"] = time.perf_counter() - t1
         label = "approximate +round +order"
         approx_info = mad.to_dict(K)
@@ -413,11 +441,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         approx_info["orders_tried"] = info["orders_tried"]
     else:
         t1 = time.perf_counter()
-        ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances)
+        ex = exchange_design(robot, K, criterion, cons, noise, seed, exchange_starts, grid, tolerances=tolerances,
+                             step=step)
         timing["exchange"] = time.perf_counter() - t1
         starts = [(f"{scheme} scheme", base)] if base is not None else []
         t1 = time.perf_counter()
-        cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances)
+        cont = continuous_design(robot, K, criterion, cons, noise, seed, n_starts, starts, tolerances=tolerances,
+                                 step=step)
         timing["continuous"] = time.perf_counter() - t1
         nlp = cont.pop("nlp")
         cands = [("continuous", cont["poses"], cont["objective"]), ("exchange", ex["poses"], ex["objective"])]
@@ -435,11 +465,14 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
                 polished.append((label + " +ipopt", Pp, op))
             else:
                 polished.append((label, P, _objective(robot, criterion, P, noise, tolerances)))
+            step()
         timing["order_polish"] = time.perf_counter() - t2
         polished = [c for c in polished if not check_design(robot, c[1], cons)]
         if not polished:
             raise DesignError("neither method produced a design that meets the constraints")
         label, P, _ = min(polished, key=lambda c: c[2])
+    if progress is not None and done[0] < total:  # a random start that found no feasible design: done anyway
+        progress(total, total)
     report = evaluate(robot, P, criterion, noise, cons, tolerances, requirement)
     timing["total"] = time.perf_counter() - t0
     cert = None

@@ -1,25 +1,27 @@
 """K ordered poses from a design measure: efficient rounding, replicates, visiting order.
 
 Realisation of K poses (:func:`realize`): efficient rounding (Pukelsheim &
-Rieder 1992) of the support's weights to counts; replicates of a support
-point on a lattice around it (hexagonal in 2-D, face-centred cubic in 3-D,
-spacing the minimum separation) inside the feasible set and the travel
-window; the visiting order cycles through the support points (stride
-scheduling, never the same point twice in a row, several cycle orders tried
-and the best kept by the exact criterion).
+Rieder 1992) of the support's weights to counts (none above ``(K + 1) // 2``);
+*true replicates*: each support point visited as many times as its count,
+the same pose again (a measurement or pose file of the design says revisits
+are intended, :mod:`zerocal_sym.io.measurement_checks`); the visiting order
+cycles through the support points (stride scheduling, never the same point
+twice in a row: a zero change carries no information; several cycle orders
+tried and the best kept by the exact criterion).  The minimum separation
+holds between distinct poses: a replicate is the support point itself.
 """
 from __future__ import annotations
 
 import itertools
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from zerocal_sym.design.constraints import Constraints, _pointwise_ok, make_constraints
+from zerocal_sym.design.constraints import Constraints, make_constraints
 from zerocal_sym.design.criteria import _criterion_terms, _criterion_weights, _noise_terms, _objective_batch
 from zerocal_sym.design.limits import DesignError
-from zerocal_sym.design.terms import _qscale, _user_scale, pose_distances, pose_terms
+from zerocal_sym.design.replicates import cap_counts, no_successive
+from zerocal_sym.design.terms import _qscale, pose_terms
 
 if TYPE_CHECKING:
     from zerocal_sym.design.approx import ApproxDesign
@@ -42,86 +44,19 @@ def efficient_rounding(w, K):
     return n
 
 
-def _lattice(n, spacing, count):
-    """Lattice offsets sorted by length, at least ``count`` of them, nearest neighbours ``spacing`` apart.
-
-    Hexagonal in 2-D, face-centred cubic in 3-D, cubic otherwise.  Shape (M, n).
-    """
-    R = 2
-    while (2 * R + 1) ** n < 3 * count + 10:
-        R += 1
-    r = np.arange(-R, R + 1)
-    ijk = np.stack(np.meshgrid(*([r] * n), indexing="ij"), axis=-1).reshape(-1, n).astype(float)
-    if n == 2:
-        B = np.array([[1.0, 0.0], [0.5, math.sqrt(3) / 2]])
-    elif n == 3:
-        B = np.array([[0.0, 1.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 0.0]]) / math.sqrt(2)
-    else:
-        B = np.eye(n)
-    off = ijk @ B * spacing
-    order = np.argsort(np.linalg.norm(off, axis=1), kind="stable")
-    return off[order]
-
-
-def place_replicates(robot, cons: Constraints, reps, counts, window=None, score=None):
-    """``counts[i]`` poses around each support point ``reps[i]``: the point itself and lattice neighbours.
-
-    Lattice spacing: the minimum separation (at least 0.01 mm); each pose
-    feasible (:func:`zerocal_sym.design.constraints._pointwise_ok`), with
-    ``rho`` inside ``window`` and at least the spacing from every pose
-    already placed.  Among the feasible lattice points near a support point
-    those with the largest ``score`` are taken (``score(Y)`` -> shape (M,):
-    the sensitivity ``d(x)`` of the optimal measure, i.e. the points that
-    lose the least information); default the nearest.
+def place_replicates(reps, counts):
+    """``counts[i]`` visits of each support point ``reps[i]``: true replicates (the same pose again).
 
     Returns
     -------
     P : ndarray, shape (K, n)
     label : ndarray of int, shape (K,)
         The support point of each pose.
-
-    Raises
-    ------
-    DesignError
-        If a support point has too few feasible neighbours.
     """
-    n = robot.n
-    sp = max(cons.min_separation_mm, 0.01) * (1 + 1e-6)
-    us = _user_scale(robot)  # the lattice in file units: a degree of an orientation counts as a mm
-    P, lab = [np.empty((0, n))], [np.empty(0, int)]
-    placed = np.empty((0, n))
-    for i, (x, c) in enumerate(zip(np.atleast_2d(reps), counts)):
-        if c <= 0:
-            continue
-        m = 3 * c + 10
-        while True:
-            Y = x + _lattice(n, sp, m)[:m] / us
-            ok = _pointwise_ok(robot, Y, cons)
-            if window is not None and np.any(ok):
-                rho = pose_terms(robot, Y[ok])["rho"]
-                okk = (rho >= window[0] - 1e-9) & (rho <= window[1] + 1e-9)
-                ok[np.flatnonzero(ok)] = okk
-            if len(placed) and np.any(ok):
-                dist = np.min(pose_distances(robot, Y[ok], placed), axis=1)
-                ok[np.flatnonzero(ok)] = dist >= sp * (1 - 1e-9)
-            good = Y[ok]
-            if len(good) >= c:
-                if score is not None and len(good) > c:
-                    pool = good[:max(3 * c, c + 6)]
-                    sc = score(pool)
-                    sc[0] = np.inf if np.allclose(pool[0], x) else sc[0]  # the support point itself first
-                    good = pool[np.argsort(-sc, kind="stable")[:c]]
-                else:
-                    good = good[:c]
-                break
-            if m > 64 * c + 2000:
-                raise DesignError(f"cannot place {c} poses {sp:g} mm apart around the support point "
-                                  f"{np.round(x, 3).tolist()} mm within the constraints")
-            m *= 4
-        P.append(good)
-        lab.append(np.full(c, i))
-        placed = np.vstack([placed, good])
-    return np.vstack(P), np.concatenate(lab)
+    reps = np.atleast_2d(np.asarray(reps, float))
+    counts = np.asarray(counts, int)
+    lab = np.repeat(np.arange(len(counts)), counts)
+    return reps[lab].copy(), lab
 
 
 def _interleave(counts, priority, rho=None, label_rho=None, l0=None):
@@ -155,6 +90,8 @@ def _interleave(counts, priority, rho=None, label_rho=None, l0=None):
         left[j] -= 1
         seq[k] = j
         prev = j
+    if K > 1 and np.any(seq[1:] == seq[:-1]) and l0 is None:  # stride order ran into one point: greedy order
+        seq = no_successive(counts, priority)
     return seq
 
 
@@ -176,7 +113,7 @@ def realize(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None, no
     P : ndarray, shape (K, n)
         Poses in visiting order.
     info : dict
-        ``counts`` per support point, ``objective`` (exact, internal),
+        ``counts`` per support point, ``objective`` (exact, internal; the independent noise alone),
         ``orders_tried``.
     """
     from zerocal_sym.model.noise import NoiseModel
@@ -188,9 +125,8 @@ def realize(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None, no
     if len(reps) > K:  # every support point gets a pose (small weights can carry the identifiability)
         keep = np.argsort(-ws)[:K]
         reps, ws = reps[keep], ws[keep] / ws[keep].sum()
-    counts = efficient_rounding(ws, K)
-    window = ad.window if cons.travel_mode == "range" else None
-    P, lab = place_replicates(robot, cons, reps, counts, window, ad.sensitivity(robot, noise))
+    counts = cap_counts(efficient_rounding(ws, K), ws)
+    P, lab = place_replicates(reps, counts)
     sm2, sx2 = _noise_terms(noise, robot)
     wt = _criterion_weights(robot, criterion, tolerances)
     t = pose_terms(robot, P)
@@ -217,12 +153,14 @@ def realize(robot, ad: ApproxDesign, K: int, cons: Constraints | None = None, no
             nxt[j] += 1
         if l0 is not None and np.any(np.abs(np.diff(rho[idx])) > l0):
             continue
+        if K > 1 and np.any(seq[1:] == seq[:-1]):  # a zero change (the travel rule left no other way)
+            continue
         o = float(_objective_batch(criterion, aq[idx][None], v[idx][None], sm2, wt)[0])
         if best is None or o < best[0]:
             best = (o, idx)
     if best is None:
         raise DesignError(f"no visiting order of the {K} poses keeps every change of rho within "
-                          f"l0 = {cons.travel_mm:g} mm")
+                          f"l0 = {cons.travel_mm:g} mm without visiting a pose twice in a row")
     o, idx = best
     return P[idx], {"counts": counts.tolist(), "support": reps.tolist(), "objective": o,
                     "orders_tried": len(prios)}

@@ -5,10 +5,12 @@ For each pose: the inverse-kinematics joints, the singularity indicators
 AD of the generated mechanism functions, at zero source errors), and the
 q-unit scaling of the sensitivities (see :mod:`zerocal_sym.design.criteria`).
 
-The design parameters are the mechanism's identified set
-``robot.errors.resolve("paper")`` (``"paper"`` is the alias of ``"default"``):
-the m zero offsets then the measuring errors it identifies, in the mechanism's
-source-error order.  The units of the reports: joint quantities (joints, zero
+The design parameters are the robot's identified set
+``robot.errors.resolve(robot.identified_set)``: by default ``"paper"`` (the
+alias of ``"default"``), the m zero offsets then the measuring errors it
+identifies, in the mechanism's source-error order; a design for another set
+(``zerocal design --params paper+L1,L2,L3``) is made for
+``robot.identifying("paper+L1,L2,L3")``.  The units of the reports: joint quantities (joints, zero
 offsets, their CRLB and bias, joint limits) in the joints' file unit, keys named
 after it (:func:`okey`); poses in file units (:func:`poses_to_user`).
 """
@@ -35,8 +37,9 @@ def _reachable(ratio, theta, tol: float = 0.0) -> np.ndarray:
 
 
 def design_params(robot) -> tuple:
-    """Names of the design parameters: the zero offsets and the MAEMM (the paper's set), p = m + n."""
-    return robot.errors.resolve("paper")
+    """Names of the design parameters: the robot's identified set (default the paper's: the zero offsets and the
+    MAEMM, p = m + n; :attr:`Robot.identified_set <zerocal_sym.model.robot.Robot.identified_set>`)."""
+    return robot.errors.resolve(getattr(robot, "identified_set", "paper"))
 
 
 # --------------------------------------------------------------------------- units of the reports
@@ -66,12 +69,16 @@ def noise_dict(robot, noise) -> dict:
     (``sigma_servo_deg`` for revolute joints, ``sigma_joint_mm`` for prismatic ones)."""
     j = float(offsets_to_user(robot, noise.sigma_joint))
     name = "sigma_servo_deg" if robot.mechanism.joint_kind == "revolute" else okey(robot, "sigma_joint")
-    return {"sigma_scale_mm": float(noise.sigma_scale_mm), name: j}
+    out = {"sigma_scale_mm": float(noise.sigma_scale_mm), name: j}
+    if noise.sigma_revisit_mm:
+        out["sigma_revisit_mm"] = float(noise.sigma_revisit_mm)
+    return out
 
 
 def joint_sigma(robot, noise_d: dict) -> float:
     """The joint term of a :func:`noise_dict` (file units)."""
-    return next(v for k, v in noise_d.items() if k.startswith("sigma_") and k != "sigma_scale_mm")
+    return next(v for k, v in noise_d.items() if k.startswith("sigma_") and k not in ("sigma_scale_mm",
+                                                                                        "sigma_revisit_mm"))
 
 
 def noise_source(robot, noise) -> str:
@@ -96,7 +103,8 @@ def describe_noise(robot, noise) -> str:
         return "paper (Eq. 34 scale + Eq. 35 servo)"
     j = float(offsets_to_user(robot, noise.sigma_joint))
     terms = (f"scale {noise.sigma_scale_mm:g} mm per change + joint {j:g} {offset_unit(robot)} per joint per "
-             "pose")
+             "pose" + (f" + {noise.sigma_revisit_mm:g} mm per pose shared by its revisits" if noise.has_shared
+                       else ""))
     src = noise_source(robot, noise)
     return f"the robot's ({src}): {terms}" if src else terms
 
@@ -146,14 +154,19 @@ def offset_positions(robot) -> list:
 
 
 # --------------------------------------------------------------------------- per-pose terms
+def pose_terms_fn(robot):
+    """:func:`_pose_terms_fn` of the robot's mechanism and identified set (:func:`design_params`)."""
+    return _pose_terms_fn(robot.mechanism_name, design_params(robot))
+
+
 @lru_cache(maxsize=None)
-def _pose_terms_fn(mech_name: str):
+def _pose_terms_fn(mech_name: str, params: tuple | None = None):
     """CasADi Function (P[n], g[G]) -> theta[m], ratio[m], s[s], rho, a[p], dth[m], ao[r].
 
-    ``a = d rho / d (zero offsets, MAEMM)`` (per rad, per mm; the paper's
-    parameter set, p = m + n), ``dth = d rho / d theta`` (per rad) and
-    ``ao = d rho / d (omitted errors)`` (the r source errors not in the
-    paper's set, :func:`omitted_params`), exact derivatives at zero source
+    ``a = d rho / d (params)`` (per rad, per mm; default the paper's
+    parameter set, the zero offsets and the MAEMM, p = m + n), ``dth = d rho / d theta`` (per rad) and
+    ``ao = d rho / d (omitted errors)`` (the r source errors not in
+    ``params``, :func:`omitted_params`), exact derivatives at zero source
     errors, joints from the inverse kinematics.
     """
     import casadi as ca
@@ -162,7 +175,7 @@ def _pose_terms_fn(mech_name: str):
 
     mech = get_mechanism(mech_name)
     n, m = mech.n, mech.m
-    idx = mech.errors.indices("paper")
+    idx = mech.errors.indices("paper" if params is None else params)
     P = ca.SX.sym("P", n)
     g = ca.SX.sym("g", mech["ik"].size1_in(1))
     theta, ratio = mech["ik"](P, g)
@@ -199,7 +212,7 @@ def pose_terms(robot, P) -> dict:
     """
     P = np.atleast_2d(np.asarray(P, float))
     K = len(P)
-    f = _pose_terms_fn(robot.mechanism_name)
+    f = pose_terms_fn(robot)
     out = f(P.T, robot.geometry)
     names = ("theta", "ratio", "s", "rho", "a", "dth", "ao")
     res = {nm: o.full().T.reshape(K, -1) for nm, o in zip(names, out)}
@@ -286,7 +299,7 @@ def _tolerance_columns(robot, tolerances):
     """
     from zerocal_sym.identify import bias
 
-    tol = bias.default_tolerances(robot) if tolerances is None else tolerances
+    tol = bias.default_tolerances(robot, design_params(robot)) if tolerances is None else tolerances
     t = bias.tolerance_vector(robot, tol, omitted_params(robot))
     return t if _bias_model(tolerances) == "worst" else t / np.sqrt(3.0)
 

@@ -10,7 +10,7 @@ from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import DesignError
-from zerocal_sym.design.terms import offsets_to_user, okey
+from zerocal_sym.design.terms import design_params, offsets_to_user, okey
 
 #: default true zero offsets (deg), the first m of them: joint 1, 2, 3 (planar: Table 2 group 1)
 DEFAULT_OFFSETS_DEG = (2.0, -1.0, 0.5)
@@ -40,8 +40,6 @@ def default_true_errors(robot) -> np.ndarray:
     DesignError
         A mechanism with more joints or identified measuring errors than these lists (give ``err_true``).
     """
-    from zerocal_sym.design.terms import design_params
-
     errors = robot.errors
     z = errors.zero_offsets
     keep = set(design_params(robot))
@@ -115,14 +113,14 @@ def verify_design(robot, P, n_trials: int, noise: NoiseModel | None = None, err_
     offsets = errors.zero_offsets
     true_off = errors.take(err, offsets)
     theta = kin.ik(robot, np.asarray(P, float))
-    mc = one_shot_monte_carlo(robot, theta, err, int(n_trials), noise, "paper", seed=seed, workers=workers,
+    mc = one_shot_monte_carlo(robot, theta, err, int(n_trials), noise, design_params(robot), seed=seed, workers=workers,
                               scheduler=scheduler, progress=progress)
     ok = mc["success"]
     failed = int(np.sum(~ok))
     m = len(offsets)
     E = offsets_to_user(robot, mc["estimate"][ok][:, [mc["params"].index(n) for n in offsets]]
                         - true_off).reshape(-1, m)
-    crlb = fisher.crlb_zero_offsets_user(robot, theta, "paper", noise, err0=err)
+    crlb = fisher.crlb_zero_offsets_user(robot, theta, design_params(robot), noise, err0=err)
     k = lambda stem: okey(robot, stem)  # noqa: E731
     return {"n_trials": int(n_trials), "n_failed": failed, "offset_names": list(offsets),
             "unit": units.joint_unit(robot),

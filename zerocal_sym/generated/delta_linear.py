@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/delta_linear.py
-inputs hash: 080dfb2abb99c2f3
+inputs hash: f2759ec97f203427
 sympy: 1.14.0
 """
 import casadi as ca
@@ -62,6 +62,7 @@ FUNCTION_SIGNATURES = {
     'g_row': ([('P', 3), ('theta', 3), ('g', 16)], [('row', (1, 6))]),
     'distance': ([('theta_cmd', 3), ('g', 16), ('err', 15)], [('rho', (1, 1))]),
     'gauge': ([('g', 16)], [('Z', (15, 4))]),
+    'sketch': ([('P', 3), ('theta', 3), ('g', 16)], [('segments', (3, 24))]),
 }
 
 
@@ -815,6 +816,47 @@ def _gauge(g):
         ca.horzcat(1, 0, 0, 0),
     )
     return (Z,)
+
+
+def _sketch(P, theta, g):
+    """The robot drawn as line segments (columns 2k and 2k+1: the ends of segment k), mm."""
+    x = P[0]
+    y = P[1]
+    z = P[2]
+    s1 = theta[0]
+    s2 = theta[1]
+    s3 = theta[2]
+    R1 = g[0]
+    R2 = g[1]
+    R3 = g[2]
+    phi1 = g[3]
+    phi2 = g[4]
+    phi3 = g[5]
+    r = g[9]
+    t0 = ca.cos(phi1)
+    t1 = R1*t0
+    t2 = ca.cos(phi2)
+    t3 = R2*t2
+    t4 = ca.cos(phi3)
+    t5 = R3*t4
+    t6 = r*t0 + x
+    t7 = r*t2 + x
+    t8 = r*t4 + x
+    t9 = ca.sin(phi1)
+    t10 = R1*t9
+    t11 = ca.sin(phi2)
+    t12 = R2*t11
+    t13 = ca.sin(phi3)
+    t14 = R3*t13
+    t15 = r*t9 + y
+    t16 = r*t11 + y
+    t17 = r*t13 + y
+    segments = ca.vertcat(
+        ca.horzcat(t1, t3, t3, t5, t5, t1, t1, t1, t1, t6, t3, t3, t3, t7, t5, t5, t5, t8, t6, t7, t7, t8, t8, t6),
+        ca.horzcat(t10, t12, t12, t14, t14, t10, t10, t10, t10, t15, t12, t12, t12, t16, t14, t14, t14, t17, t15, t16, t16, t17, t17, t15),
+        ca.horzcat(0, 0, 0, 0, 0, 0, 0, s1, s1, z, 0, s2, s2, z, 0, s3, s3, z, z, z, z, z, z, z),
+    )
+    return (segments,)
 
 
 def build_functions():

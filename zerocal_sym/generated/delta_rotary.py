@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: c8b9c6693ac6318d
+inputs hash: 91caec1dd74dbdcc
 sympy: 1.14.0
 """
 import casadi as ca
@@ -68,6 +68,7 @@ FUNCTION_SIGNATURES = {
     'g_row': ([('P', 3), ('theta', 3), ('g', 22)], [('row', (1, 6))]),
     'distance': ([('theta_cmd', 3), ('g', 22), ('err', 21)], [('rho', (1, 1))]),
     'gauge': ([('g', 22)], [('Z', (21, 2))]),
+    'sketch': ([('P', 3), ('theta', 3), ('g', 22)], [('segments', (3, 24))]),
 }
 
 
@@ -1318,6 +1319,65 @@ def _gauge(g):
         ca.horzcat(1, 0),
     )
     return (Z,)
+
+
+def _sketch(P, theta, g):
+    """The robot drawn as line segments (columns 2k and 2k+1: the ends of segment k), mm."""
+    x = P[0]
+    y = P[1]
+    z = P[2]
+    theta1 = theta[0]
+    theta2 = theta[1]
+    theta3 = theta[2]
+    R1 = g[0]
+    R2 = g[1]
+    R3 = g[2]
+    phi1 = g[3]
+    phi2 = g[4]
+    phi3 = g[5]
+    z1 = g[6]
+    z2 = g[7]
+    z3 = g[8]
+    L1 = g[9]
+    L2 = g[10]
+    L3 = g[11]
+    r = g[15]
+    t0 = ca.cos(phi1)
+    t1 = R1*t0
+    t2 = ca.cos(phi2)
+    t3 = R2*t2
+    t4 = ca.cos(phi3)
+    t5 = R3*t4
+    t6 = L1*ca.cos(theta1)
+    t7 = t0*t6 + t1
+    t8 = r*t0 + x
+    t9 = L2*ca.cos(theta2)
+    t10 = t2*t9 + t3
+    t11 = r*t2 + x
+    t12 = L3*ca.cos(theta3)
+    t13 = t12*t4 + t5
+    t14 = r*t4 + x
+    t15 = ca.sin(phi1)
+    t16 = R1*t15
+    t17 = ca.sin(phi2)
+    t18 = R2*t17
+    t19 = ca.sin(phi3)
+    t20 = R3*t19
+    t21 = t15*t6 + t16
+    t22 = r*t15 + y
+    t23 = t17*t9 + t18
+    t24 = r*t17 + y
+    t25 = t12*t19 + t20
+    t26 = r*t19 + y
+    t27 = -L1*ca.sin(theta1) + z1
+    t28 = -L2*ca.sin(theta2) + z2
+    t29 = -L3*ca.sin(theta3) + z3
+    segments = ca.vertcat(
+        ca.horzcat(t1, t3, t3, t5, t5, t1, t1, t7, t7, t8, t3, t10, t10, t11, t5, t13, t13, t14, t8, t11, t11, t14, t14, t8),
+        ca.horzcat(t16, t18, t18, t20, t20, t16, t16, t21, t21, t22, t18, t23, t23, t24, t20, t25, t25, t26, t22, t24, t24, t26, t26, t22),
+        ca.horzcat(z1, z2, z2, z3, z3, z1, z1, t27, t27, z, z2, t28, t28, z, z3, t29, t29, z, z, z, z, z, z, z),
+    )
+    return (segments,)
 
 
 def build_functions():

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/hexapod.py
-inputs hash: 7a5b06fb05dfef00
+inputs hash: 86b7b6a846bca3ea
 sympy: 1.14.0
 """
 import casadi as ca
@@ -98,6 +98,7 @@ FUNCTION_SIGNATURES = {
     'distance': ([('theta_cmd', 6), ('g', 58), ('err', 48)], [('rho', (1, 1))]),
     'gauge': ([('g', 58)], [('Z', (48, 12))]),
     'home_pose': ([('g', 58)], [('P0', (6, 1))]),
+    'sketch': ([('P', 6), ('theta', 6), ('g', 58)], [('segments', (3, 36))]),
 }
 
 
@@ -2621,6 +2622,132 @@ def _home_pose(g):
     z_home = g[2]
     P0 = ca.vertcat(0, 0, z_home, 0, 0, 0)
     return (P0,)
+
+
+def _sketch(P, theta, g):
+    """The robot drawn as line segments (columns 2k and 2k+1: the ends of segment k), mm."""
+    x = P[0]
+    y = P[1]
+    z = P[2]
+    roll = P[3]
+    pitch = P[4]
+    yaw = P[5]
+    Rb = g[0]
+    Rp = g[1]
+    beta1 = g[4]
+    beta2 = g[5]
+    beta3 = g[6]
+    beta4 = g[7]
+    beta5 = g[8]
+    beta6 = g[9]
+    pi1 = g[10]
+    pi2 = g[11]
+    pi3 = g[12]
+    pi4 = g[13]
+    pi5 = g[14]
+    pi6 = g[15]
+    b1x = g[16]
+    b1y = g[17]
+    b1z = g[18]
+    b2x = g[19]
+    b2y = g[20]
+    b2z = g[21]
+    b3x = g[22]
+    b3y = g[23]
+    b3z = g[24]
+    b4x = g[25]
+    b4y = g[26]
+    b4z = g[27]
+    b5x = g[28]
+    b5y = g[29]
+    b5z = g[30]
+    b6x = g[31]
+    b6y = g[32]
+    b6z = g[33]
+    q1x = g[34]
+    q1y = g[35]
+    q1z = g[36]
+    q2x = g[37]
+    q2y = g[38]
+    q2z = g[39]
+    q3x = g[40]
+    q3y = g[41]
+    q3z = g[42]
+    q4x = g[43]
+    q4y = g[44]
+    q4z = g[45]
+    q5x = g[46]
+    q5y = g[47]
+    q5z = g[48]
+    q6x = g[49]
+    q6y = g[50]
+    q6z = g[51]
+    t0 = Rb*ca.cos(beta1) + b1x
+    t1 = Rb*ca.cos(beta2) + b2x
+    t2 = Rb*ca.cos(beta3) + b3x
+    t3 = Rb*ca.cos(beta4) + b4x
+    t4 = Rb*ca.cos(beta5) + b5x
+    t5 = Rb*ca.cos(beta6) + b6x
+    t6 = Rp*ca.cos(pi1) + q1x
+    t7 = ca.cos(yaw)
+    t8 = ca.cos(pitch)
+    t9 = t7*t8
+    t10 = ca.sin(roll)
+    t11 = ca.sin(yaw)
+    t12 = t10*t11
+    t13 = ca.sin(pitch)
+    t14 = ca.cos(roll)
+    t15 = t14*t7
+    t16 = t12 + t13*t15
+    t17 = Rp*ca.sin(pi1) + q1y
+    t18 = t11*t14
+    t19 = t10*t7
+    t20 = t13*t19 - t18
+    t21 = q1z*t16 + t17*t20 + t6*t9 + x
+    t22 = Rp*ca.cos(pi2) + q2x
+    t23 = Rp*ca.sin(pi2) + q2y
+    t24 = q2z*t16 + t20*t23 + t22*t9 + x
+    t25 = Rp*ca.cos(pi3) + q3x
+    t26 = Rp*ca.sin(pi3) + q3y
+    t27 = q3z*t16 + t20*t26 + t25*t9 + x
+    t28 = Rp*ca.cos(pi4) + q4x
+    t29 = Rp*ca.sin(pi4) + q4y
+    t30 = q4z*t16 + t20*t29 + t28*t9 + x
+    t31 = Rp*ca.cos(pi5) + q5x
+    t32 = Rp*ca.sin(pi5) + q5y
+    t33 = q5z*t16 + t20*t32 + t31*t9 + x
+    t34 = Rp*ca.cos(pi6) + q6x
+    t35 = Rp*ca.sin(pi6) + q6y
+    t36 = q6z*t16 + t20*t35 + t34*t9 + x
+    t37 = Rb*ca.sin(beta1) + b1y
+    t38 = Rb*ca.sin(beta2) + b2y
+    t39 = Rb*ca.sin(beta3) + b3y
+    t40 = Rb*ca.sin(beta4) + b4y
+    t41 = Rb*ca.sin(beta5) + b5y
+    t42 = Rb*ca.sin(beta6) + b6y
+    t43 = t11*t8
+    t44 = t13*t18 - t19
+    t45 = t12*t13 + t15
+    t46 = q1z*t44 + t17*t45 + t43*t6 + y
+    t47 = q2z*t44 + t22*t43 + t23*t45 + y
+    t48 = q3z*t44 + t25*t43 + t26*t45 + y
+    t49 = q4z*t44 + t28*t43 + t29*t45 + y
+    t50 = q5z*t44 + t31*t43 + t32*t45 + y
+    t51 = q6z*t44 + t34*t43 + t35*t45 + y
+    t52 = t14*t8
+    t53 = t10*t8
+    t54 = q1z*t52 - t13*t6 + t17*t53 + z
+    t55 = q2z*t52 - t13*t22 + t23*t53 + z
+    t56 = q3z*t52 - t13*t25 + t26*t53 + z
+    t57 = q4z*t52 - t13*t28 + t29*t53 + z
+    t58 = q5z*t52 - t13*t31 + t32*t53 + z
+    t59 = q6z*t52 - t13*t34 + t35*t53 + z
+    segments = ca.vertcat(
+        ca.horzcat(t0, t1, t1, t2, t2, t3, t3, t4, t4, t5, t5, t0, t21, t24, t24, t27, t27, t30, t30, t33, t33, t36, t36, t21, t0, t21, t1, t24, t2, t27, t3, t30, t4, t33, t5, t36),
+        ca.horzcat(t37, t38, t38, t39, t39, t40, t40, t41, t41, t42, t42, t37, t46, t47, t47, t48, t48, t49, t49, t50, t50, t51, t51, t46, t37, t46, t38, t47, t39, t48, t40, t49, t41, t50, t42, t51),
+        ca.horzcat(b1z, b2z, b2z, b3z, b3z, b4z, b4z, b5z, b5z, b6z, b6z, b1z, t54, t55, t55, t56, t56, t57, t57, t58, t58, t59, t59, t54, b1z, t54, b2z, t55, b3z, t56, b4z, t57, b5z, t58, b6z, t59),
+    )
+    return (segments,)
 
 
 def build_functions():

@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: de3321a116718645
+inputs hash: 3fdd91c664b358a1
 sympy: 1.14.0
 """
 import casadi as ca
@@ -60,6 +60,7 @@ FUNCTION_SIGNATURES = {
     'distance': ([('theta_cmd', 2), ('g', 12), ('err', 12)], [('rho', (1, 1))]),
     'gauge': ([('g', 12)], [('Z', (12, 3))]),
     'error_jacobian_full': ([('P', 2), ('theta', 2), ('g', 12)], [('J_full', (2, 10))]),
+    'sketch': ([('P', 2), ('theta', 2), ('g', 12)], [('segments', (2, 10))]),
 }
 
 
@@ -440,6 +441,29 @@ def _error_jacobian_full(P, theta, g):
         ca.horzcat(-t18*t34, -t22*t34, t31, -t25*t34, t26*t34, -t29*t36, -t34*t35, -t15*t36, -t32*t36, t33*t36),
     )
     return (J_full,)
+
+
+def _sketch(P, theta, g):
+    """The robot drawn as line segments (columns 2k and 2k+1: the ends of segment k), mm."""
+    x = P[0]
+    y = P[1]
+    theta1 = theta[0]
+    theta2 = theta[1]
+    e1x = g[0]
+    e1y = g[1]
+    e2x = g[2]
+    e2y = g[3]
+    L1 = g[4]
+    L2 = g[5]
+    t0 = L1*ca.cos(theta1) + e1x
+    t1 = L2*ca.cos(theta2) + e2x
+    t2 = L1*ca.sin(theta1) + e1y
+    t3 = L2*ca.sin(theta2) + e2y
+    segments = ca.vertcat(
+        ca.horzcat(e1x, e2x, e1x, t0, t0, x, e2x, t1, t1, x),
+        ca.horzcat(e1y, e2y, e1y, t2, t2, y, e2y, t3, t3, y),
+    )
+    return (segments,)
 
 
 def build_functions():

@@ -21,14 +21,15 @@ identified parameter ``i`` (model: first order, the errors independent)
 * RMS ``sqrt(sum_j S_ij^2 t_j^2 / 3)``: the root mean square bias when each
   ``e_j`` is uniform on ``[-t_j, t_j]`` (variance ``t_j^2 / 3``).
 
-Defaults (:func:`default_tolerances`): for the paper's planar robot the
-magnitudes of Table 2's geometric error set A (``e1x`` 0.03 mm, ``e1y`` 0.02,
-``e2x`` 0.02, ``e2y`` 0.01, ``L1`` 0.01, ``L2`` 0.02, ``l1`` 0.03, ``l2`` 0.02
-mm) as an example of a machining tolerance; for any other mechanism
+Defaults (:func:`default_tolerances`): the robot's own
+(:meth:`Robot.tolerances <zerocal_sym.model.robot.Robot.tolerances>`: its
+file's ``[tolerances]`` table, else those of a robot measured by hand,
 :data:`DEFAULT_LENGTH_TOLERANCE_MM` per length and
-:data:`DEFAULT_ANGLE_TOLERANCE_DEG` per angle.  Tolerances are given in user
-units (mm, deg) by name: ``NAME=VALUE`` items, a TOML or JSON file of
-``name = value``, and a scale factor (``10`` for ten times set A).
+:data:`DEFAULT_ANGLE_TOLERANCE_DEG` per angle; the paper's robot carries the
+magnitudes of Table 2's set A: :mod:`zerocal_sym.model.tolerances`).  They
+are overridden in user units (mm, deg) by name or group (``L`` for ``L1 L2
+L3``, as in the table): ``NAME=VALUE`` items, a TOML or JSON file of ``name =
+value``, and a scale factor (``10`` for ten times set A).
 
 The MAEMM (identified) and the gauge: the omitted errors include the ones
 that fix the mechanism's gauge (planar ``e1x e1y e2y``); part of their effect
@@ -44,16 +45,9 @@ import numpy as np
 from zerocal_sym.errors import ZerocalError
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.noise import NoiseModel
+# the defaults of a robot measured by hand (mm, deg), kept importable from here
+from zerocal_sym.model.tolerances import DEFAULT_ANGLE_TOLERANCE_DEG, DEFAULT_LENGTH_TOLERANCE_MM  # noqa: F401
 
-#: Default tolerance of an omitted length error, mm (mechanisms without a table below).
-DEFAULT_LENGTH_TOLERANCE_MM = 0.02
-#: Default tolerance of an omitted angle error, deg.
-DEFAULT_ANGLE_TOLERANCE_DEG = 0.002
-#: Per-mechanism defaults (user units).  planar_2dof: |Table 2 set A| (mm), an example tolerance.
-MECHANISM_TOLERANCES = {
-    "planar_2dof": {"e1x": 0.03, "e1y": 0.02, "e2x": 0.02, "e2y": 0.01,
-                    "L1": 0.01, "L2": 0.02, "l1": 0.03, "l2": 0.02},
-}
 #: The model of the RMS bias: independent errors uniform within their tolerances.
 RMS_MODEL = "independent uniform errors in [-t, t] (variance t^2/3)"
 
@@ -86,22 +80,11 @@ def omitted(robot, params="paper") -> tuple:
 
 
 def default_tolerances(robot, params="paper") -> dict:
-    """Default tolerances of the omitted errors by name, internal units (mm, rad).
-
-    The mechanism's table (:data:`MECHANISM_TOLERANCES`) where it has one,
-    else :data:`DEFAULT_LENGTH_TOLERANCE_MM` per length and
-    :data:`DEFAULT_ANGLE_TOLERANCE_DEG` per angle.
-    """
-    table = MECHANISM_TOLERANCES.get(robot.mechanism_name, {})
-    errors = robot.errors
-    out = {}
-    for name in omitted(robot, params):
-        if name in table:
-            v = table[name]
-        else:
-            v = DEFAULT_ANGLE_TOLERANCE_DEG if errors[name].unit == "rad" else DEFAULT_LENGTH_TOLERANCE_MM
-        out[name] = errors.from_user_value(name, v)
-    return out
+    """Default tolerances of the omitted errors by name, internal units (mm, rad): the robot's
+    (:meth:`Robot.tolerances <zerocal_sym.model.robot.Robot.tolerances>`: its file's ``[tolerances]``, else
+    :data:`DEFAULT_LENGTH_TOLERANCE_MM` per length and :data:`DEFAULT_ANGLE_TOLERANCE_DEG` per angle)."""
+    own = robot.tolerances()
+    return {name: own[name] for name in omitted(robot, params)}
 
 
 def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="paper", defaults: bool = True,
@@ -111,7 +94,9 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
     Parameters
     ----------
     items : sequence of str, optional
-        ``NAME=VALUE`` in user units (mm; deg for angles), later ones win.
+        ``NAME=VALUE`` in user units (mm; deg for angles), later ones win; ``NAME`` an omitted error or a
+        group or set of them (:func:`zerocal_sym.model.tolerances.keys`: ``L`` for ``L1 L2 L3``; an entry
+        wins over a group, a smaller group over a larger one); they override the robot's own.
     file : path, optional
         TOML (``name = value``) or JSON (``{"name": value}``) file, user units;
         applied before ``items``.
@@ -138,9 +123,14 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
         if not sep:
             raise ZerocalError(f"--tolerance {it!r}: expected NAME=VALUE (mm; deg for angles)")
         given[k.strip()] = v
-    for k, v in given.items():
-        if k not in names:
-            what = "is identified (no bias from it)" if k in errors.names else "is not a source error"
+    from zerocal_sym.model import tolerances as tl
+
+    by_key = tl.keys(errors)
+    for k, v in sorted(given.items(), key=lambda kv: -len(by_key.get(kv[0], ()))):  # an entry wins over its group
+        members = [n for n in by_key.get(k, ()) if n in names]
+        if not members:
+            what = ("is identified (no bias from it)" if k in errors.names or k in by_key else
+                    "is not a source error or a group of them")
             raise ZerocalError(f"tolerance {k!r} {what}; tolerances apply to {', '.join(names)}")
         try:
             val = float(v)
@@ -150,7 +140,8 @@ def make_tolerances(robot, items=None, file=None, scale: float = 1.0, params="pa
             raise ZerocalError(f"tolerance {k}: an integer of {len(str(v))} digits: must be finite") from None
         if not math.isfinite(val) or val < 0:
             raise ZerocalError(f"tolerance {k}={v!r}: must be finite and >= 0")
-        tol[k] = errors.from_user_value(k, val)
+        for n in members:
+            tol[n] = errors.from_user_value(n, val)
     try:
         scale = float(scale)
     except (TypeError, ValueError):

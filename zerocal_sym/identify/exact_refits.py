@@ -51,15 +51,44 @@ class _Exact:
     def z_prior(self):
         return self.mu * self.scale
 
+    @property
+    def shared(self) -> bool:
+        """Whether the noise has the revisits' shared error (the covariance is more than the bands)."""
+        return self.noise.has_shared and not self.noise.is_zero
+
     def evaluate(self, z):
-        """``(r, rp, J, pred, l, b)`` at ``z`` (weights at ``z``); copies."""
+        """``(r, rp, J, pred, l, b)`` at ``z`` (weights at ``z``); copies.  With the revisits' shared error
+        ``r`` and the data rows of ``J`` are whitened by the full covariance (:meth:`covariance`)."""
         last = getattr(self, "_last", None)
         if last is not None and np.array_equal(last[0], z):
             return last[1]
         fast = self.prob.fast
         l, b = (np.array(o, float) for o in fast["weights"](z, self.par))
         r, rp, J, pred = (np.array(o, float) for o in fast["residuals"](z, self.par, l, b))
-        return r.ravel(), rp.ravel(), J, pred.ravel(), l.ravel(), b.ravel()
+        r, J, pred, l, b = r.ravel(), np.reshape(J, (-1, np.size(z))), pred.ravel(), l.ravel(), b.ravel()
+        if self.shared:
+            from zerocal_sym.identify.nlls_shared import pred_jacobian
+
+            C = self.covariance(z)
+            J = np.vstack([C.whiten(-pred_jacobian(l, b, J, self.K)), J[self.K - 1:]])
+            r = C.whiten(self.readings[1:] - pred)
+        return r, rp.ravel(), J, pred, l, b
+
+    def covariance(self, z):
+        """The covariance of the changes at ``z`` (:func:`~zerocal_sym.identify.fisher.change_covariance`)."""
+        from zerocal_sym.identify.fisher import change_covariance
+
+        err = self.robot.errors.put(self.prior_q, self.names, np.asarray(z, float) / self.scale)
+        return change_covariance(self.robot, self.theta, self.noise, err)
+
+    def raw(self, z):
+        """``(e, A)`` at ``z``: the residuals of the changes (mm) and ``d pred / d z`` (K-1, p)."""
+        from zerocal_sym.identify.nlls_shared import pred_jacobian
+
+        fast = self.prob.fast
+        l, b = (np.array(o, float) for o in fast["weights"](z, self.par))
+        _, _, J, pred = (np.array(o, float) for o in fast["residuals"](z, self.par, l, b))
+        return self.readings[1:] - pred.ravel(), pred_jacobian(l, b, J, self.K)
 
     def prior_rows(self) -> np.ndarray:
         return np.flatnonzero(np.any(self.w != 0, axis=1))
@@ -72,15 +101,15 @@ class _Exact:
         basis = np.eye(self.p) if basis is None else np.asarray(basis, float)
         rr = np.concatenate([r, rp[rows]])
         JJ = np.vstack([J[:K1], J[K1:][rows]]) @ basis
-        return _Linear(rr, JJ, (l, b), np.arange(1, self.K), self.readings[1:] - pred, basis,
-                       self.scale, self.names, len(rows), point)
+        return _Linear(rr, JJ, self.covariance(z) if self.shared else (l, b), np.arange(1, self.K),
+                       self.readings[1:] - pred, basis, self.scale, self.names, len(rows), point)
 
     def refine(self, z0, basis=None, max_iter: int = 10):
         """Gauss-Newton on the exact model from ``z0`` within ``span(basis)`` (weights re-evaluated)."""
         from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
 
         z = np.asarray(z0, float).copy()
-        if basis is None or (np.shape(basis)[1] == self.p and not np.any(self.w)):
+        if not self.shared and (basis is None or (np.shape(basis)[1] == self.p and not np.any(self.w))):
             # the whole space: the nlls problem's Gauss-Newton blocks (one CasADi call per 3 iterations)
             z_gn, step, r, rp, J, pred, l, b = self.prob.run_gauss_newton(z, self.par, True, GN_STEP_TOL)
             if np.all(np.isfinite(z_gn)) and float(step[0]) < GN_STEP_TOL:
@@ -106,6 +135,15 @@ class _Exact:
 
     def chi2_fit(self, theta=None, readings=None):
         """chi² and dof of the exact-model least-squares fit (from the prior) to altered data."""
+        if self.shared:  # the full covariance: Gauss-Newton in numpy on a copy with the altered data
+            alt = _Exact(self.robot, self.theta if theta is None else theta,
+                         self.readings if readings is None else readings, self.names, self.prior_q, self.noise,
+                         self.w if np.any(self.w) else None)
+            try:
+                lin = alt.linear(alt.refine(alt.z_prior, max_iter=30))
+            except (FloatingPointError, np.linalg.LinAlgError, ValueError):
+                return float("inf"), (self.K - 1) + len(self.prior_rows()) - self.p
+            return (float(lin.r @ lin.r) if lin.valid else float("inf")), lin.dof
         par = self.par.copy()
         K = self.K
         if theta is not None:
@@ -130,7 +168,12 @@ class _Exact:
 
 def _without_each(exact: "_Exact", z_est=None, select=None) -> dict:
     """Exact refits without each single reading, from the prior and from ``z_est``; the lower chi² per reading
-    (:func:`~zerocal_sym.identify.leave_out.without_each`; ``select``: the readings refitted exactly)."""
+    (:func:`~zerocal_sym.identify.leave_out.without_each`; ``select``: the readings refitted exactly).  With
+    the revisits' shared error: :func:`zerocal_sym.identify.revisit_refits.without_each_shared`."""
+    if exact.shared:
+        from zerocal_sym.identify.revisit_refits import without_each_shared
+
+        return without_each_shared(exact, z_est, select)
     starts = [exact.z_prior] if z_est is None or np.allclose(z_est, exact.z_prior) else [exact.z_prior, z_est]
     rnd = _Round(exact.robot, exact.theta, exact.readings, exact.names, exact.prior_q, exact.noise,
                  exact.w if np.any(exact.w) else None)

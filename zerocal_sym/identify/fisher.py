@@ -8,7 +8,9 @@ with the exact derivatives of the generated distance model (CasADi AD).  Noise:
 * servo error ``xi_k ~ N(0, sigma_xi^2 I_2)`` on each pose's joints, propagated
   to first order: ``Cov(rho_k) = sigma_xi^2 |d rho_k / d theta|^2`` (independent
   poses), so ``Cov(s) = sigma_m^2 I + D diag(Cov(rho)) D^T`` (correlated:
-  consecutive changes share a pose).
+  consecutive changes share a pose);
+* optionally a pose's systematic error shared by its revisits (``sigma_r``):
+  ``Cov(rho) += sigma_r^2 Z Z^T`` (:mod:`zerocal_sym.identify.covariance`).
 
 ``F = A^T Cov(s)^-1 A (+ prior precision)``; the CRLB of any unbiased estimator
 is ``F^-1``.
@@ -16,13 +18,15 @@ is ``F^-1``.
 ``Cov(s)`` is tridiagonal: it is kept as its two bands
 (:class:`ChangeCovariance`, :func:`change_covariance`) and whitened by its
 lower-bidiagonal Cholesky factor, so memory and time are linear in K (the
-dense :func:`measurement_covariance` is for small K and tests).
+dense :func:`measurement_covariance` is for small K and tests).  The shared
+revisit error adds a low-rank part, one column per revisited pose, kept
+exact by Woodbury (O(K G)).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym.identify import banded
+from zerocal_sym.identify.covariance import ChangeCovariance, band_forward  # noqa: F401 - importable from here
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 from zerocal_sym.errors import PoseError
@@ -71,134 +75,22 @@ def sensitivity(robot, theta_cmd, params="paper", err0=None):
     return np.diff(de[:, robot.errors.indices(params)], axis=0)
 
 
-class ChangeCovariance:
-    """``Cov(s) = sigma_m^2 I + D diag(v) D^T`` of the K-1 measured changes, kept as its two bands.
+def pose_labels(robot, theta_cmd) -> np.ndarray:
+    """The pose of each visit, shape (K,) (:func:`zerocal_sym.model.revisits.pose_groups` on the commanded
+    joints in their file unit, to :data:`~zerocal_sym.model.revisits.REVISIT_TOL`)."""
+    from zerocal_sym.model.revisits import REVISIT_TOL, pose_groups
 
-    Tridiagonal, (K-1) x (K-1): diagonal ``sigma_m^2 + v_k + v_{k+1}``,
-    sub-diagonal ``-v_{k+1}`` (consecutive changes share a pose), ``v_k`` the
-    variance of ``rho_k`` from the servo error.  Its Cholesky factor ``L`` is
-    lower bidiagonal (diagonal ``l``, sub-diagonal ``b``); whitening ``L^-1 A``
-    is a forward substitution.  Memory and time O(K) (O(K p) for a (K-1, p)
-    matrix): nothing here is (K-1) x (K-1) unless :meth:`dense` is asked for.
-
-    Attributes
-    ----------
-    diag : ndarray, shape (K-1,)
-    off : ndarray, shape (K-2,)
-        ``C[k+1, k] = C[k, k+1]``.
-    """
-
-    def __init__(self, diag, off):
-        self.diag = np.asarray(diag, float).ravel()
-        self.off = np.asarray(off, float).ravel()
-        if self.off.size != max(self.diag.size - 1, 0):
-            raise ValueError(f"off-diagonal of length {self.off.size} for a diagonal of {self.diag.size}")
-        self._chol = None
-
-    @classmethod
-    def from_variances(cls, sigma_scale_mm: float, var_rho) -> "ChangeCovariance":
-        """From ``sigma_m`` (mm) and ``v`` (K,), the variance of each pose's distance (mm^2)."""
-        v = np.asarray(var_rho, float).ravel()
-        return cls(sigma_scale_mm**2 + v[:-1] + v[1:], -v[1:-1])
-
-    @property
-    def n(self) -> int:
-        return self.diag.size
-
-    @property
-    def is_zero(self) -> bool:
-        return not (np.any(self.diag) or np.any(self.off))
-
-    def dense(self) -> np.ndarray:
-        """The full matrix, shape (K-1, K-1) (small problems and tests only)."""
-        C = np.diag(self.diag)
-        if self.n > 1:
-            i = np.arange(self.n - 1)
-            C[i + 1, i] = C[i, i + 1] = self.off
-        return C
-
-    def std(self) -> np.ndarray:
-        """Standard deviation of each change, shape (K-1,)."""
-        return np.sqrt(self.diag)
-
-    def cholesky(self):
-        """``(l, b)``: ``C = L L^T`` with ``L`` lower bidiagonal (``L[k, k] = l[k]``, ``L[k+1, k] = b[k]``).
-
-        Raises
-        ------
-        numpy.linalg.LinAlgError
-            ``C`` is not positive definite (a zero noise model).
-        """
-        if self._chol is None:
-            l, b, ok = banded.cholesky(self.diag, self.off)
-            if not ok:
-                raise np.linalg.LinAlgError("the covariance of the changes is not positive definite")
-            self._chol = (l, b)
-        return self._chol
-
-    def whiten(self, A) -> np.ndarray:
-        """``L^-1 A`` (identity covariance), shape of ``A``: (K-1,) or (K-1, p); O(K p)."""
-        l, b = self.cholesky()
-        return band_forward(l, b, A)
-
-    def factor_times(self, A) -> np.ndarray:
-        """``A L``, ``A`` shape (p, K-1): then ``A C A^T = (A L)(A L)^T`` without the (K-1)^2 matrix."""
-        l, b = self.cholesky()
-        A = np.asarray(A, float)
-        out = A * l
-        if self.n > 1:
-            out[:, :-1] += A[:, 1:] * b
-        return out
-
-    def sandwich(self, A) -> np.ndarray:
-        """``A C A^T`` for ``A`` (p, K-1), O(K p^2) (works for a singular C too)."""
-        A = np.asarray(A, float)
-        out = (A * self.diag) @ A.T
-        if self.n > 1:
-            X = (A[:, 1:] * self.off) @ A[:, :-1].T
-            out += X + X.T
-        return out
-
-    def whitener(self) -> np.ndarray:
-        """``L^-1`` dense, shape (K-1, K-1) (small problems only)."""
-        return self.whiten(np.eye(self.n))
-
-    def solve(self, V) -> np.ndarray:
-        """``C^-1 V``, ``V`` shape (K-1,) or (K-1, p); O(K p)."""
-        l, b = self.cholesky()
-        return banded.solve(l, b, V)
-
-    def inverse_diagonal(self) -> np.ndarray:
-        """The diagonal of ``C^-1``, shape (K-1,); O(K)."""
-        return banded.inverse_diagonal(*self.cholesky())
-
-    def take(self, keep) -> "ChangeCovariance":
-        """The covariance of the changes ``keep`` (sorted indices), the others marginalised out: tridiagonal."""
-        return ChangeCovariance(*banded.submatrix(self.diag, self.off, keep))
-
-    def plus_diagonal(self, x) -> "ChangeCovariance":
-        """``C + diag(x)``, ``x`` shape (K-1,)."""
-        return ChangeCovariance(self.diag + np.asarray(x, float), self.off)
-
-
-def band_forward(l, b, A) -> np.ndarray:
-    """Solve ``L Y = A`` for lower-bidiagonal ``L`` (diagonal ``l`` (n,), sub-diagonal ``b`` (n-1,)).
-
-    The recurrence ``y_k = (a_k - b_{k-1} y_{k-1}) / l_k`` evaluated as a
-    parallel prefix (log2 n vectorised steps of ``y_k = alpha_k y_{k-1} +
-    beta_k``), O(n p log n) flops, O(n p) memory.
-    """
-    A = np.asarray(A, float)
-    return banded.forward(np.ravel(np.asarray(l, float)), np.ravel(np.asarray(b, float)), A.reshape(A.shape[0], -1)
-                          ).reshape(A.shape)
+    return pose_groups(units.joints_to_user(robot, np.atleast_2d(theta_cmd)), REVISIT_TOL)
 
 
 def change_covariance(robot, theta_cmd, noise: NoiseModel, err0=None) -> ChangeCovariance:
-    """Covariance of the K-1 measured changes in band form (:class:`ChangeCovariance`), O(K)."""
+    """Covariance of the K-1 measured changes in band form (:class:`ChangeCovariance`), O(K); with a shared
+    revisit error (``noise.sigma_revisit_mm``) its revisited poses' low-rank part, O(K G)."""
     theta_cmd = np.atleast_2d(theta_cmd)
     _, _, dt = kin.distance_jacobians(robot, theta_cmd, err0)
     var_rho = noise.sigma_servo_rad**2 * np.sum(dt**2, axis=1)
-    return ChangeCovariance.from_variances(noise.sigma_scale_mm, var_rho)
+    labels = pose_labels(robot, theta_cmd) if noise.has_shared else None
+    return ChangeCovariance.from_variances(noise.sigma_scale_mm, var_rho, labels, noise.sigma_revisit_mm)
 
 
 def measurement_covariance(robot, theta_cmd, noise: NoiseModel, err0=None):

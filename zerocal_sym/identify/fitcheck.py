@@ -105,7 +105,7 @@ def _exact_for(robot, meas, result, noise=None) -> tuple:
     info = result.info
     if noise is None:
         nd = info.get("noise")
-        noise = NoiseModel(nd["sigma_scale_mm"], nd["sigma_servo_rad"]) if nd else NoiseModel.paper()
+        noise = NoiseModel.from_dict(nd) if nd else NoiseModel.paper()
     prior_q = np.asarray(info.get("prior", robot.errors.zeros()), float)
     w = info.get("prior_whitener")
     exact = _Exact(robot, meas.theta_cmd, meas.readings, result.params, prior_q, noise,

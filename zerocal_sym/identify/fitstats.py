@@ -33,7 +33,9 @@ class _Linear:
     rows; ``J`` (N, c) whitened Jacobian w.r.t. the fitted coordinates;
     ``band = (l, b)`` the lower-bidiagonal Cholesky factor of the data rows'
     covariance (diagonal ``l`` (n,), sub-diagonal ``b`` (n-1,)) they are
-    whitened with; ``poses`` (n,) the pose index k of each data row; ``raw``
+    whitened with, or the covariance itself when it is more than the bands
+    (a :class:`~zerocal_sym.identify.covariance.ChangeCovariance` with the
+    shared revisit error: its ``whiten`` is the whitening); ``poses`` (n,) the pose index k of each data row; ``raw``
     (n,) residuals in mm; ``basis`` (p, c) maps the fitted coordinates to the
     scaled parameters ``z`` (``p = z / scale``).  ``svd``: the caller's thin
     SVD of ``J`` (its U may carry extra zero rows below); ``terms``: the
@@ -53,6 +55,10 @@ class _Linear:
         self.n = self.poses.size
         self.n_prior_rows = int(n_prior_rows)
         self.point = point
+        self._cov = None
+        if hasattr(band, "whiten_transpose"):  # the covariance (bands + shared part): its whitening
+            self._cov = band
+            band = band.cholesky()
         l, b = (np.ravel(np.asarray(x, float)) for x in band)
         self._band, self._terms = (l, b), terms
         #: False when the exact model cannot be evaluated there (a pose is not an assembly with these errors)
@@ -72,7 +78,7 @@ class _Linear:
         self.U, self.s, self.Vt = U[:, : self.rank], s[: self.rank], Vt[: self.rank]
         self.dof = self.n + self.n_prior_rows - self.rank
         if self._terms is not None and (self.rank != self.J.shape[1] or self.n_prior_rows
-                                        or self.r.size != self.n):
+                                        or self.r.size != self.n or self._cov is not None):
             self._terms = None  # the terms assume full column rank and no prior rows
 
     def per_reading(self, moves: bool = True):
@@ -80,10 +86,11 @@ class _Linear:
         estimated error of the reading (mm) and the change of ``z`` (n, p) when the reading is removed
         (None with ``moves=False``).
 
-        With ``a_j = [L^-1 e_j; 0]`` the whitened indicator of reading j and
-        ``H = U U^T`` the hat matrix: ``aa_j = |a_j|^2`` (the diagonal of
-        ``C^-1``), ``U^T a_j`` (row j of ``L^-T U_data``), ``a_j^T r`` (entry
-        j of ``L^-T r_data``): every term from bidiagonal solves, O(n c).
+        With ``a_j = [W e_j; 0]`` the whitened indicator of reading j (``W = L^-1``
+        for the bands) and ``H = U U^T`` the hat matrix: ``aa_j = |a_j|^2`` (the
+        diagonal of ``C^-1``), ``U^T a_j`` (row j of ``W^T U_data``), ``a_j^T r``
+        (entry j of ``W^T r_data``): every term from bidiagonal solves, O(n c)
+        (O(n (c + G)) with the shared revisit error).
         """
         n = self.n
         if self._terms is not None:  # computed by the caller (the same quantities)
@@ -95,10 +102,15 @@ class _Linear:
             nan = np.full(n, np.nan)
             return nan, np.ones(n), nan.copy(), (np.full((n, self.basis.shape[0]), np.nan) if moves else None)
         l, b = self._band
-        aa = banded.inverse_diagonal(l, b)
-        UA = banded.backward(l, b, self.U[:n]).T          # (rank, n): column j is U^T a_j
+        if self._cov is None:
+            aa = banded.inverse_diagonal(l, b)
+            WT = lambda V: banded.backward(l, b, V)  # noqa: E731 - W^T = L^-T
+        else:
+            aa = self._cov.inverse_diagonal()
+            WT = self._cov.whiten_transpose
+        UA = WT(self.U[:n]).T                             # (rank, n): column j is U^T a_j
         den = aa - np.sum(UA * UA, axis=0)                # a^T (I - H) a
-        num = banded.backward(l, b, self.r[:n]) - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
+        num = WT(self.r[:n]) - UA.T @ (self.U.T @ self.r)   # a^T (I - H) r
         with np.errstate(divide="ignore", invalid="ignore"):
             lev = np.where(aa > 0, 1.0 - den / aa, 1.0)
             ok = den > LEVERAGE_TOL * aa
@@ -117,7 +129,10 @@ class _Linear:
 
 
 def _noise_dict(noise) -> dict:
-    return {"sigma_scale_mm": float(noise.sigma_scale_mm), "sigma_servo_rad": float(noise.sigma_servo_rad)}
+    d = {"sigma_scale_mm": float(noise.sigma_scale_mm), "sigma_servo_rad": float(noise.sigma_servo_rad)}
+    if getattr(noise, "sigma_revisit_mm", 0):
+        d["sigma_revisit_mm"] = float(noise.sigma_revisit_mm)
+    return d
 
 
 def _fmt_p(p) -> str:

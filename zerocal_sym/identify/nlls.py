@@ -46,7 +46,7 @@ import time
 import numpy as np
 
 from zerocal_sym.identify import fisher, fitcheck
-from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear
+from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear, _noise_dict
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, initial, prior_whitener,
                                              scaled_bounds)
@@ -169,6 +169,9 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
             raise ValueError(f"loss_scale must be positive, got {loss_scale!r}")
         if bounds is not None:
             raise ValueError("a robust loss does not take bounds")
+        if noise.has_shared:
+            raise ValueError("a robust loss does not take a shared revisit error (the noise model's "
+                             "sigma_revisit_mm, [noise] revisit_std_mm): use loss 'l2'")
     errors = robot.errors
     names = errors.resolve(params)
     theta_cmd, readings = check_measurements(robot, meas)
@@ -186,6 +189,12 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     z0 = x0 * scale if bounds is None else np.clip(x0 * scale, lbx, ubx)  # (clipping to +-inf: no-op)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, s, scale, mu, w, *noise_terms(noise))
     sol = solve(prob, z0, par, reweight, bounds is not None, lbx, ubx, max_iter, K)
+    sol.cov = sol.A = None
+    if noise.has_shared and not noise.is_zero:  # the full covariance (not tridiagonal): on from the banded fit
+        from zerocal_sym.identify.nlls_shared import revisit_stage
+
+        revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale, K,
+                      *((lbx, ubx) if bounds is not None else ()))
     robust = A = None
     robust_failed = None
     if loss != "l2":
@@ -209,8 +218,10 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "dof": (K - 1) - len(names),
         "time_s": None,
         "weighting": ("unit (1 um), covariance from residuals" if noise.is_zero else
-                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"),
-        "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
+                      "errors-in-variables: whitened by the banded chol(Cov(s)), servo error propagated"
+                      + ("; the revisits' shared error by the full covariance (Gauss-Newton from the banded "
+                         "fit)" if sol.cov is not None else "")),
+        "noise": _noise_dict(noise),
         "warm_start": start,
         "gauss_newton": {"converged": sol.gn_ok, "last_step_mm": sol.step},
         "initial": x0.tolist(),
@@ -233,11 +244,11 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     rows = np.flatnonzero(np.any(w != 0, axis=1))
     if robust is None:
         terms = None
-        if not rows.size and rank == len(names) and "fit_terms" in prob.fast:  # the per-reading terms, O(K p)
-            terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]
+        if not rows.size and rank == len(names) and "fit_terms" in prob.fast and sol.cov is None:
+            terms = [o.copy() for o in prob.fast["fit_terms"](r, Jd, l, b)]  # the per-reading terms, O(K p)
         lin = _Linear(np.concatenate([r, rp[rows]]) if rows.size else r,
                       np.vstack([Jd, J[K - 1:][rows]]) if rows.size else Jd,
-                      (l, b), np.arange(1, K), s - pred, np.eye(len(names)),
+                      (l, b) if sol.cov is None else sol.cov, np.arange(1, K), s - pred, np.eye(len(names)),
                       scale, names, len(rows),
                       svd=None if rows.size else svd,  # no prior rows: J's SVD is Jd's
                       terms=terms)
@@ -255,8 +266,42 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                           prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     if robust is not None:
         _limit_outliers(res, robust, loss, K, accept_misfit)
+        _unchecked_after_removal(res, robust, loss, K, accept_misfit)
+    from zerocal_sym.identify.nlls_shared import revisits_entry
+
+    revisits_entry(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)
     info["time_s"] = time.perf_counter() - t0
     return res
+
+
+def _unchecked_after_removal(res, robust, loss, K, accept_misfit):
+    """Refuse a robust fit that left no spare degree of freedom once its outliers were left out.
+
+    Without a spare degree of freedom the fit check cannot test what is left
+    (any readings fit), so nothing says the readings left out were the bad
+    ones: with one reading 0.18 mm off on a Delta ring of K = 8 the Huber
+    loss left out a good one and the offsets came out 2.5 deg off with a
+    1 sigma of 0.07 deg.  ``accept_misfit`` keeps it, saying so.
+    """
+    fit = res.info["fit"]
+    if not robust["excluded_readings"] or fit.get("checked") or fit.get("dof", 1) > 0 or not res.success:
+        return
+    poses = ", ".join(map(str, robust["excluded_readings"]))
+    why = (f"the {loss} loss left out the reading(s) at pose {poses}, and the {K - 1 - len(robust['excluded_readings'])}"
+           f" readings left give no spare degree of freedom: the fit cannot be checked, so nothing shows that the "
+           "readings left out were the bad ones")
+    fit["unchecked_after_removal"] = True
+    if accept_misfit:
+        res.status = f"accepted despite misfit (unchecked: {why}); {res.status}"
+        fit["accepted_despite_misfit"] = True
+    else:
+        res.success = False
+        res.status = f"rejected: {why}"
+        fit["rejected"] = True
+    fit["diagnosis"] = (f"The {loss} loss left out the reading(s) at pose {poses}; the readings left fit any "
+                        "parameters exactly (no spare degree of freedom), so the fit is not checked. Measure more "
+                        "poses (or re-measure the pose(s) left out) and identify again; --accept-misfit keeps it "
+                        "unchecked.")
 
 
 def _limit_outliers(res, robust, loss, K, accept_misfit):
@@ -334,7 +379,9 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
 
     For outside solvers (``scipy.optimize.least_squares``) on exactly the
     problem Ipopt solves with ``warm_start=None, reweight=0`` (weights at
-    ``prior``, no bounds, no Gaussian prior).
+    ``prior``, no bounds, no Gaussian prior); with the shared revisit error
+    whitened by the full covariance at ``prior`` (the problem
+    :func:`identify_nlls` goes on to).
 
     ``callbacks``: ``"plain"`` calls the CasADi Functions the ordinary way
     (numpy converted in and out); ``"fast"`` through zero-copy buffers
@@ -360,10 +407,19 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
                     errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
     fs = prob.functions
     l, b = (o.full().ravel() for o in fs["weights"](errors.take(prior_q, names) * scale, par))
+    if callbacks not in ("plain", "fast"):
+        raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
     if callbacks == "fast":
         rfun, jfun = FastCall(fs["rfun"]), FastCall(fs["jfun"])
-        return (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy()), scale
-    if callbacks != "plain":
-        raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
-    rfun, jfun = fs["rfun"], fs["jfun"]
-    return (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full()), scale
+        fun, jac = (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy())
+    else:
+        rfun, jfun = fs["rfun"], fs["jfun"]
+        fun, jac = (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full())
+    if noise.has_shared and not noise.is_zero:  # the full covariance at the prior: W L0 (L0 r = the residuals)
+        from zerocal_sym.identify import banded
+
+        C = fisher.change_covariance(robot, theta_cmd, noise, prior_q)
+        return ((lambda z: C.whiten(banded.times_factor(l, b, fun(z)))),
+                (lambda z: C.whiten(banded.times_factor(l, b, np.reshape(jac(z), (theta_cmd.shape[0] - 1, -1))))),
+                scale)
+    return fun, jac, scale

@@ -133,6 +133,8 @@ class IdentificationResult(units.DegreeViews):
             "residuals_mm": np.asarray(self.residuals).tolist(),
             "std_kind": self.std_kind,
             "fit": _json_ready(self.info.get("fit")) if isinstance(self.info, dict) else None,
+            **({"revisits": _json_ready(self.info["revisits"])}
+               if isinstance(self.info, dict) and "revisits" in self.info else {}),
         }
 
 

@@ -195,10 +195,14 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     b = readings[1:] - np.diff(lam)
     s = np.linalg.svd(G, compute_uv=False)
     if s[-1] <= RANK_RTOL * s[0]:
+        from zerocal_sym.identify.identifiability import null_space_phrase
+
         rank = int(np.sum(s > RANK_RTOL * s[0]))
+        why = null_space_phrase(robot, th, names, err0=prior)
         raise IdentificationError(
-            f"identification matrix G has rank {rank} < {p}: the measuring-mechanism vectors of the poses "
-            "are degenerate, the offsets and the MAEMM cannot be identified", where=meas.source)
+            f"identification matrix G has rank {rank} < {p}: the offsets and the MAEMM cannot be identified from "
+            f"these poses ({why or 'the measuring-mechanism vectors of the poses are degenerate'}); measure other "
+            "poses", where=meas.source)
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if spread[1] <= COLLINEAR_RTOL * spread[0]:
         raise IdentificationError(
@@ -245,7 +249,25 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
                           fitcheck.DEFAULT_ALPHA if fit_alpha is None else fit_alpha, accept_misfit,
                           evaluated_at=honest["_evaluated_at"])
     res.info["fit"]["chi2_at_estimate"] = honest["_chi2_at_estimate"]
+    _revisits(res, robot, th, exact, np.asarray(info["fit_point"]) * exact.scale)
     return res
+
+
+def _revisits(res, robot, th, exact, z):
+    """``info["revisits"]`` when the round revisits a pose (:func:`zerocal_sym.identify.revisits.revisit_report`,
+    at the fit check's point)."""
+    from zerocal_sym.identify.revisits import has_revisits, revisit_report
+
+    if not has_revisits(robot, th):
+        return
+    try:
+        e, A = exact.raw(z)
+        rep = revisit_report(robot, th, e, A, exact.noise, exact.robot.errors.put(exact.prior_q, exact.names,
+                                                                                   z / exact.scale))
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+        rep = {"reason": f"not estimated: {exc}"}
+    if rep is not None:
+        res.info["revisits"] = rep
 
 
 def _estimate(errors, names, prior, sol, s, T, P, maemm_prior):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from zerocal_sym.identify.exact_refits import _Exact
+from zerocal_sym.identify.fitstats import _noise_dict
 
 
 def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_noise) -> dict:
@@ -37,8 +38,7 @@ def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_nois
     r_est = exact.evaluate(z_est)[0]
     out = {"_exact": exact, "_basis": basis, "_chi2_at_estimate": float(r_est @ r_est),
            "_std_kind": "total" if noise is not None else "from residuals",
-           "prior": prior_eff.tolist(), "noise": {"sigma_scale_mm": nm.sigma_scale_mm,
-                                                  "sigma_servo_rad": nm.sigma_servo_rad},
+           "prior": prior_eff.tolist(), "noise": _noise_dict(nm),
            "fit_basis": basis.tolist(),
            "covariance_noise": None if cov_noise is None else np.asarray(cov_noise).tolist()}
     notes = []

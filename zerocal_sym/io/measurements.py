@@ -189,7 +189,7 @@ def format_template(theta_cmd, target=None, meta=None, mechanism=None) -> str:
 
 # --------------------------------------------------------------------------- reading
 
-def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measurements:
+def load_measurements(path, robot=None, min_poses: int = MIN_POSES, allow_revisits: bool = False) -> Measurements:
     """Read and validate a measurement CSV.
 
     Parameters
@@ -208,6 +208,10 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
         (none named) of the default mechanism.
     min_poses : int
         At least this many poses (5 for the paper's 4 parameters).
+    allow_revisits : bool
+        Accept a pose visited again after other poses (a design's
+        replicates) without the file's ``# revisits: allowed`` line.  A pose
+        right after itself (a zero change) is refused either way.
 
     Returns
     -------
@@ -263,7 +267,14 @@ def load_measurements(path, robot=None, min_poses: int = MIN_POSES) -> Measureme
     if K < min_poses:
         raise DataFileError(f"too few poses: {K} (at least {min_poses} are needed to identify the parameters)",
                             where=src)
-    _check_duplicates(meas, cols)
+    _check_duplicates(meas, cols, allow_revisits)
     if robot is not None:
         check_against_robot(meas, robot)
     return meas
+
+
+def read_metadata(path) -> dict:
+    """The ``# key: value`` lines of a measurement file, without reading its rows (e.g. its ``robot_sha256``
+    before the file is checked against a robot)."""
+    text, src = _read_text(path)
+    return _split_csv(text, src, "# zerocal measurements", FORMAT_VERSION)[0]

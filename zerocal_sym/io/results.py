@@ -22,6 +22,10 @@ is an error, not silently ignored: ``estimate`` and ``std`` against
 against ``robot.mechanism``; the robot hashes (``robot_sha256``,
 ``robot.sha256``, ``robot_hash``: 64 hexadecimal digits each) against each
 other.  Standard deviations are >= 0 or null.
+
+The error budget (``error_budget``, ``limited_by``; optional: files written
+before it keep loading) is checked against the offsets' standard deviations
+and itself: :mod:`zerocal_sym.io.result_budget`.
 """
 from __future__ import annotations
 
@@ -36,6 +40,7 @@ from zerocal_sym.errors import DataFileError
 from zerocal_sym.model.units import DegreeViews
 from zerocal_sym.io.csvtext import (_json_line, _load_json, _read_text, get_mechanism_of, read_as,
                                     unknown_mechanism_message, with_reading_hint)
+from zerocal_sym.io.result_budget import check_error_budget
 
 #: the unit of the zero offsets at the file edge of a revolute mechanism (a prismatic one's: mm); every key that
 #: names them is made from the unit here (:func:`offset_keys`)
@@ -385,5 +390,7 @@ def load_result(path, allow_failed: bool = False, robot=None) -> ResultFile:
     fits(_check_names, obj, "joint_names", mech.joint_names, text, src)
     fits(_check_names, obj, "pose_names", mech.pose_names, text, src)
     std = _compensation(obj, names, off, std, mech.joint_names, text, src, unit)
+    fits(check_error_budget, obj, mech, std, unit, text, src, SAME_VALUE_TOL)
     return ResultFile(off, std, maemm, obj.get("method") or "?", status, success, _find_sha(obj, text, src), obj, src,
                       mechanism=mech.name, estimate=estimate, std=stds, units=units, offset_unit=unit)
+

@@ -270,3 +270,41 @@ def distance_jacobians(robot, theta_cmd, err=None):
     err = robot.errors.zeros() if err is None else robot.errors.check_vector(err)
     rho, de, dt = _call(robot, "distance_jacobians", theta_cmd, robot.geometry, err)
     return rho[:, 0, 0], de[:, 0, :], dt[:, 0, :]
+
+
+def sketch(robot, P, theta=None):
+    """The robot drawn as line segments at K poses: its mechanism's optional ``sketch`` output, or None.
+
+    Parameters
+    ----------
+    P : ndarray, shape (K, n)
+    theta : ndarray, shape (K, m), optional
+        The joints (default: the inverse kinematics of ``P``).
+
+    Returns
+    -------
+    ndarray, shape (K, s, 2, l) or None
+        Segment k of pose i runs from ``[i, k, 0]`` to ``[i, k, 1]`` (l = 2 or 3 coordinates, mm); None when
+        the mechanism draws no sketch.
+    """
+    if "sketch" not in robot.mechanism.functions:
+        return None
+    P = _cols(P, robot.n)
+    theta = ik(robot, P, check=False) if theta is None else _cols(theta, robot.m)
+    seg = _call(robot, "sketch", P, theta, robot.geometry)[0]  # (K, l, 2 s)
+    K, dim, cols = seg.shape
+    return seg.reshape(K, dim, cols // 2, 2).transpose(0, 2, 3, 1)
+
+
+def measuring_line(robot, P):
+    """The measuring mechanism's ends at K poses: ``O1 = c`` on the base and ``O2 = c + lambda(P)``.
+
+    Returns
+    -------
+    ndarray, shape (K, 2, l)
+        mm.
+    """
+    lam, lam_hat = measuring_vector(robot, P)
+    c = robot.params(robot.mechanism.measuring_base)
+    o2 = c[None, :] + lam[:, None] * lam_hat
+    return np.stack([np.broadcast_to(c, o2.shape), o2], axis=1)

@@ -11,12 +11,17 @@ Noise (paper Section 6.1, each switchable and scalable):
   ``sigma_m = (3 + l0/1000)/3 um`` with ``l0 = 350 mm`` (Eq. 34);
 * joint positioning error per joint per pose ``xi ~ N(0, sigma_xi^2)``, in the
   joints' unit; the paper's servo error (revolute joints)
-  ``sigma_xi = (1/3)(4/10^4)(1/eta) 360 deg`` with ``eta = 20`` (Eq. 35).
+  ``sigma_xi = (1/3)(4/10^4)(1/eta) 360 deg`` with ``eta = 20`` (Eq. 35);
+* a per-pose systematic error of the measured length ``u_g ~ N(0, sigma_r^2)``
+  (mm, default 0), shared by every visit of pose ``g`` (revisits of a pose
+  repeat it; distinct poses have independent ones): what a revisit does not
+  average out (``[noise] revisit_std_mm``).  A pose visited once carries it
+  as one more independent error.
 
 A robot's noise (:meth:`NoiseModel.of_robot`, the ``default`` of
 :data:`NOISE_NAMES`) is its robot file's ``[noise]`` (``scale`` mm, ``joint``
-in the joints' unit), else its mechanism's default (the linear Delta's
-0.002 mm and 0.005 mm), else the paper's.
+in the joints' unit, ``revisit_std_mm``), else its mechanism's default (the
+linear Delta's 0.002 mm and 0.005 mm), else the paper's (no shared error).
 """
 from __future__ import annotations
 
@@ -54,10 +59,14 @@ class NoiseModel:
     sigma_joint : float
         Std of each joint's positioning error at each pose, in the joints' internal unit (rad for revolute
         joints: the paper's servo error; mm for prismatic ones).
+    sigma_revisit_mm : float
+        Std of a pose's systematic error of the measured length, mm, shared by its revisits (default 0).
+        Needs an independent term (scale or joint) beside it.
     """
 
     sigma_scale_mm: float = 0.0
     sigma_joint: float = 0.0
+    sigma_revisit_mm: float = 0.0
 
     @property
     def sigma_servo_rad(self) -> float:
@@ -65,7 +74,7 @@ class NoiseModel:
         return self.sigma_joint
 
     def __post_init__(self):
-        for name in ("sigma_scale_mm", "sigma_joint"):
+        for name in ("sigma_scale_mm", "sigma_joint", "sigma_revisit_mm"):
             v = getattr(self, name)
             try:
                 ok = bool(np.isfinite(v) and v >= 0)
@@ -73,6 +82,15 @@ class NoiseModel:
                 ok = False
             if not ok:
                 raise ValueError(f"NoiseModel: {name} must be a finite standard deviation >= 0, got {v!r}")
+        if self.sigma_revisit_mm > 0 and self.sigma_scale_mm == 0 and self.sigma_joint == 0:
+            raise ValueError("NoiseModel: a shared revisit error (sigma_revisit_mm) needs an independent term "
+                             "beside it (sigma_scale_mm or sigma_joint): revisits of a pose would measure "
+                             "exactly the same length")
+
+    @property
+    def has_shared(self) -> bool:
+        """Whether the revisits of a pose share a systematic error (``sigma_revisit_mm > 0``)."""
+        return self.sigma_revisit_mm > 0
 
     @classmethod
     def paper(cls, scale: float = 1.0, servo: float = 1.0) -> "NoiseModel":
@@ -95,24 +113,29 @@ class NoiseModel:
         else:
             raise ValueError(f"mechanism {mech.name!r} (prismatic joints) has no default joint noise: give "
                              "[noise] joint = ... (mm) in the robot file")
-        return cls(scale, joint)
+        return cls(scale, joint, float(given.get("revisit_std_mm", 0.0)))
 
-    def scaled(self, scale: float = 1.0, joint: float = 1.0) -> "NoiseModel":
-        """Each term multiplied by a factor."""
-        return NoiseModel(self.sigma_scale_mm * scale, self.sigma_joint * joint)
+    def scaled(self, scale: float = 1.0, joint: float = 1.0, revisit: float | None = None) -> "NoiseModel":
+        """Each term multiplied by a factor (the shared revisit term by ``revisit``; default: kept unless
+        both other terms become zero)."""
+        sm, sj = self.sigma_scale_mm * scale, self.sigma_joint * joint
+        if revisit is None:
+            revisit = 1.0 if (sm > 0 or sj > 0) else 0.0
+        return NoiseModel(sm, sj, self.sigma_revisit_mm * revisit)
 
     @classmethod
     def named(cls, name: str, robot=None) -> "NoiseModel":
         """``paper`` (the robot's default) | ``scale-only`` | ``servo-only`` | ``none`` (:data:`NOISE_NAMES`).
 
-        With ``robot`` the terms are the robot's (:meth:`of_robot`); without, the paper's.
+        With ``robot`` the terms are the robot's (:meth:`of_robot`); without, the paper's.  The shared
+        revisit term belongs to ``paper`` alone (the robot's full noise).
         """
         name = NOISE_ALIASES.get(name, name) if isinstance(name, str) else name
         if name not in NOISE_NAMES:
             raise ValueError(f"unknown noise model {name!r} (known: {', '.join(NOISE_NAMES)})")
         base = cls.paper() if robot is None else cls.of_robot(robot)
-        table = {"paper": base, "scale-only": base.scaled(joint=0.0),
-                 "servo-only": base.scaled(scale=0.0), "none": cls()}
+        table = {"paper": base, "scale-only": base.scaled(joint=0.0, revisit=0.0),
+                 "servo-only": base.scaled(scale=0.0, revisit=0.0), "none": cls()}
         return table[name]
 
     @classmethod
@@ -150,16 +173,20 @@ class NoiseModel:
 
     def to_dict(self, robot=None) -> dict:
         """``{"sigma_scale_mm": ..., "sigma_servo_rad": ...}`` (revolute joints) or ``{..., "sigma_joint_mm": ...}``
-        (prismatic), the joint term in the robot's internal unit."""
+        (prismatic), the joint term in the robot's internal unit; ``sigma_revisit_mm`` when nonzero."""
         if robot is not None and robot.mechanism.joint_kind == "prismatic":
-            return {"sigma_scale_mm": float(self.sigma_scale_mm), "sigma_joint_mm": float(self.sigma_joint)}
-        return {"sigma_scale_mm": float(self.sigma_scale_mm), "sigma_servo_rad": float(self.sigma_joint)}
+            d = {"sigma_scale_mm": float(self.sigma_scale_mm), "sigma_joint_mm": float(self.sigma_joint)}
+        else:
+            d = {"sigma_scale_mm": float(self.sigma_scale_mm), "sigma_servo_rad": float(self.sigma_joint)}
+        if self.sigma_revisit_mm:
+            d["sigma_revisit_mm"] = float(self.sigma_revisit_mm)
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "NoiseModel":
         """The inverse of :meth:`to_dict`."""
         joint = d.get("sigma_servo_rad", d.get("sigma_joint_mm", d.get("sigma_joint", 0.0)))
-        return cls(d["sigma_scale_mm"], joint)
+        return cls(d["sigma_scale_mm"], joint, d.get("sigma_revisit_mm", 0.0))
 
 
 class VirtualPlant:
@@ -215,13 +242,21 @@ class VirtualPlant:
         Returns
         -------
         ndarray, shape (K,)
-            ``readings[0] = 0``; ``readings[k] = rho_k - rho_{k-1} + m_k``, mm.
+            ``readings[0] = 0``; ``readings[k] = rho_k - rho_{k-1} + m_k``, mm; with a shared revisit
+            error, ``rho_k`` carries ``u_g`` of its pose ``g`` (drawn last: the other draws are those
+            without it).
         """
         rng = np.random.default_rng(rng)
         rho = self.lengths(theta_cmd, noise, rng)
         s = np.diff(rho)
         if noise is not None and noise.sigma_scale_mm > 0:
             s = s + rng.normal(0.0, noise.sigma_scale_mm, s.shape)
+        if noise is not None and noise.has_shared:
+            from zerocal_sym.model.revisits import pose_groups
+
+            lab = pose_groups(np.atleast_2d(np.asarray(theta_cmd, float)), 0.0)  # one pose: the same commands
+            u = rng.normal(0.0, noise.sigma_revisit_mm, int(lab.max()) + 1)[lab]
+            s = s + np.diff(u)
         return np.concatenate([[0.0], s])
 
 

@@ -26,6 +26,11 @@ geometry and the workspace, in tables or (the paper's flat files) at the top::
     [noise]                           # optional: the measurement noise (default: the mechanism's, else the paper's)
     scale = 0.002                     # mm per measured change of the scale
     joint = 0.005                     # per joint per pose, in the joints' unit (deg for revolute, mm for prismatic)
+    revisit_std_mm = 0.0              # a pose's systematic error of the measured length, shared by its revisits
+
+    [tolerances]                      # optional: how well each entry is known (mm; deg for angles), for the
+    L = 1.0                           # error budget; an entry (L1), a group (L: L1 L2 L3) or a set (lengths);
+    phi2 = 0.2                        # default a robot measured by hand (zerocal_sym.model.tolerances)
 
 An alias (``L`` for ``L1 = L2``, the planar ``ex`` for ``e1x = ex, e2x = -ex``)
 sets several entries; an entry named explicitly wins over its alias (``L = 375``
@@ -68,8 +73,8 @@ LENGTH_LIMIT_MM = 1e6
 #: a geometric angle (deg) in a robot file beyond this is a unit or typing error
 ANGLE_LIMIT_DEG = 360.0
 TOP_KEYS = ("name", "mechanism", "mechanism_module", "units", "singularity_margin", "home")
-TABLES = ("geometry", "workspace", "noise")
-NOISE_KEYS = ("scale", "joint")
+TABLES = ("geometry", "workspace", "noise", "tolerances")
+NOISE_KEYS = ("scale", "joint", "revisit_std_mm")
 
 
 @dataclass(frozen=True)
@@ -85,6 +90,14 @@ class Robot:
         Home joints (internal units: rad, mm) if the file overrides the mechanism's.
     noise_values : tuple of (str, float)
         The robot file's ``[noise]`` (``scale`` mm, ``joint`` in the joints' file unit).
+    tolerance_values : tuple of (str, float)
+        The robot file's ``[tolerances]`` in table order (user units; keys as
+        :mod:`zerocal_sym.model.tolerances`): :meth:`tolerances` resolves them.
+    identified_set : str
+        The parameters a calibration of this robot estimates (a set as
+        :meth:`SourceErrors.resolve <zerocal_sym.model.source_errors.SourceErrors.resolve>`
+        takes: ``"paper"``, the default, or ``"paper+L1,L2,L3"``); what the
+        designs are made for (:meth:`identifying`).  Not in :attr:`sha256`.
     """
 
     geometry: np.ndarray
@@ -96,6 +109,8 @@ class Robot:
     home: np.ndarray | None = None
     keys: dict = field(default_factory=dict, compare=False)
     noise_values: tuple = ()
+    tolerance_values: tuple = ()
+    identified_set: str = "paper"
 
     @property
     def mechanism(self):
@@ -132,6 +147,24 @@ class Robot:
         from zerocal_sym.model.noise import NoiseModel
 
         return NoiseModel.of_robot(self)
+
+    def identifying(self, params) -> "Robot":
+        """This robot with :attr:`identified_set` = ``params`` (a set name, names joined by ``+`` or ``,``, or a
+        sequence of names); ValueError for an unknown name."""
+        import dataclasses
+
+        spec = params if isinstance(params, str) else ",".join(params)
+        self.errors.resolve(spec)  # (raises for an unknown name)
+        return dataclasses.replace(self, identified_set=spec)
+
+    def tolerances(self) -> dict:
+        """How well each entry held at the file's value is known: name -> tolerance, internal units (mm, rad),
+        for every source error but the zero offsets: the file's ``[tolerances]``, else the defaults of a robot
+        measured by hand (:mod:`zerocal_sym.model.tolerances`)."""
+        from zerocal_sym.model import tolerances as tl
+
+        errors = self.errors
+        return {n: errors.from_user_value(n, v) for n, v in tl.resolve(errors, self.tolerance_values).items()}
 
     def workspace_bounds(self):
         """Bounding box of the workspace, ``(lo, hi)`` ndarray shape (n,) each."""
@@ -233,17 +266,26 @@ def _from_keys(keys: dict, name: str, source: str, where=None) -> Robot:
                  name=name, mechanism_name=mech.name, source=source,
                  singularity_margin=float(keys.get("singularity_margin", DEFAULT_SINGULARITY_MARGIN)),
                  home=None if home is None else units.joints_from_user(mech, home), keys=dict(keys),
-                 noise_values=tuple((k, float(v)) for k, v in keys.get("noise", {}).items()))
+                 noise_values=tuple((k, float(v)) for k, v in keys.get("noise", {}).items()),
+                 tolerance_values=tuple((k, float(v)) for k, v in keys.get("tolerances", {}).items()))
 
 
 def paper_robot() -> Robot:
-    """The paper's robot (Table 1)."""
-    return _from_keys(PAPER_TABLE1, "paper", "built-in (Mei et al. 2017, Table 1)")
+    """The paper's robot (Table 1), with the magnitudes of Table 2's set A as its tolerances."""
+    from zerocal_sym.model.tolerances import PAPER_SET_A_TOLERANCES_MM
+
+    return _from_keys({**PAPER_TABLE1, "tolerances": PAPER_SET_A_TOLERANCES_MM}, "paper",
+                      "built-in (Mei et al. 2017, Table 1)")
 
 
-def _line_of(text: str, key: str):
+def _line_of(text: str, key: str, table: str | None = None):
+    """The line (1-based) of ``key`` (in ``[table]`` when given), or None."""
+    inside = table is None
     for i, line in enumerate(text.splitlines(), 1):
-        if re.match(rf"\s*({re.escape(key)}\s*=|\[\s*{re.escape(key)}\s*\])", line):
+        if table is not None and re.match(r"\s*\[", line):
+            inside = re.match(rf"\s*\[\s*{re.escape(table)}\s*\]", line) is not None
+            continue
+        if inside and re.match(rf"\s*({re.escape(key)}\s*=|\[\s*{re.escape(key)}\s*\])", line):
             return i
     return None
 
@@ -306,14 +348,24 @@ def _check_keys(keys: dict, where) -> None:
 
     allowed = TOP_KEYS + geo_keys + ws_cls.keys
     for k, v in keys.items():
+        if k == "tolerances" and isinstance(v, dict):
+            from zerocal_sym.model.tolerances import check_table
+
+            check_table(mech.errors, v, lambda key: where(key, "tolerances"), _check_number, RobotFileError,
+                        ANGLE_LIMIT_DEG)
+            continue
         if k == "noise" and isinstance(v, dict):
             for kk, vv in v.items():
                 if kk not in NOISE_KEYS:
                     raise RobotFileError(f"unknown key '{kk}' in [noise] (allowed: {', '.join(NOISE_KEYS)})",
                                          where=where(kk))
-                _check_number(kk, vv, "mm" if kk == "scale" else ju, where)
+                _check_number(kk, vv, "mm" if kk in ("scale", "revisit_std_mm") else ju, where)
                 if vv < 0:
                     raise RobotFileError(f"[noise] {kk} is a standard deviation: >= 0, got {vv!r}", where=where(kk))
+            if v.get("revisit_std_mm", 0) > 0 and v.get("scale") == 0 and v.get("joint") == 0:
+                raise RobotFileError("[noise] revisit_std_mm needs an independent term beside it (scale or joint "
+                                     "> 0): revisits of a pose would measure exactly the same length",
+                                     where=where("revisit_std_mm"))
             continue
         if k in TABLES and isinstance(v, dict):
             inner = geo_keys if k == "geometry" else ws_cls.keys + ("shape",)
@@ -395,6 +447,16 @@ def _deepest_line(text: str):
     return where if best else None
 
 
+def module_file(path) -> Path | None:
+    """The ``.py`` file a robot file's ``mechanism_module`` names (an input of every command that reads the robot
+    file), or None (no such line, a module name, or a file that does not parse: its loader says why)."""
+    try:
+        module = read_toml(path, RobotFileError, "robot file").get("mechanism_module")
+    except (RobotFileError, OSError, ValueError):
+        return None
+    return (Path(path).parent / module) if isinstance(module, str) and module.endswith(".py") else None
+
+
 def _register_module(keys: dict, path: Path, where) -> None:
     """Register the robot file's ``mechanism_module`` (a ``.py`` file relative to the file, or a module name)."""
     module = keys.get("mechanism_module")
@@ -428,8 +490,8 @@ def load_robot(path) -> Robot:
     keys = read_toml(path, RobotFileError, "robot file")
     text = path.read_text(encoding="utf-8").removeprefix("\ufeff")  # for the line numbers of the keys
 
-    def where(key):
-        line = _line_of(text, key) if key else None
+    def where(key, table=None):
+        line = (_line_of(text, key, table) or _line_of(text, key)) if key else None
         return f"{path}:{line}" if line else str(path)
 
     _register_module(keys, path, where)

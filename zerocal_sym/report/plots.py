@@ -109,7 +109,12 @@ def figure_residuals(d: dict):
     ax = fig.add_subplot(2 if two else 1, 1, 1)
     ax.bar(k, 1e3 * d["after_mm"], 0.6, color="tab:blue")
     ax.axhline(0, color="k", lw=0.6)
-    ax.set_xticks(k)
+    if len(k) <= 25:  # every pose labelled; more: integer ticks that do not overlap
+        ax.set_xticks(k)
+    else:
+        from matplotlib.ticker import MaxNLocator
+
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("residual [um]")
     ax.set_title(f"Residuals at the {d['method']} estimate (rms {1e3 * d['rms_after_mm']:.3g} um): "
                  "measured minus predicted scale change", fontsize=10)
