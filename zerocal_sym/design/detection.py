@@ -70,7 +70,7 @@ class Requirement:
                  harm_sigma: float = pw.DEFAULT_HARM_SIGMA, bad_reading_mm: float = pw.DEFAULT_BAD_READING_MM,
                  scale_error: float = pw.DEFAULT_SCALE_ERROR, entries: bool = False):
         from zerocal_sym.design.limits import DesignError
-        from zerocal_sym.design.terms import omitted_params
+        from zerocal_sym.design.terms import design_params, omitted_params
         from zerocal_sym.identify import bias
 
         checks = (("the fit check's level alpha", alpha, 0.0, 1.0), ("the power", target, 0.0, 1.0),
@@ -90,7 +90,8 @@ class Requirement:
         #: require the single entries too (not the default: module docstring), those some design can see
         self.entries = bool(entries)
         # the tolerances as every design report resolves them (the mechanism's, the robot file's, the options')
-        self.tolerances = bias.make_tolerances(robot) if tolerances is None else tolerances
+        self.tolerances = (bias.make_tolerances(robot, params=design_params(robot)) if tolerances is None
+                           else tolerances)
         self.tol = bias.tolerance_vector(robot, self.tolerances, omitted_params(robot))
         self.invisible = None  # unknown until :meth:`find_invisible`
         #: the zero offsets' range an order error's harm is judged over (q-units): what the fit check's
@@ -319,7 +320,9 @@ def _exact_orders(robot, T, noise, lam, kinds, harmless, lam_req):
     K = len(T.rho)
     readings = np.concatenate([[0.0], np.diff(T.rho)])
     try:
-        ex = _Exact(robot, T.theta, readings, robot.errors.resolve("paper"), robot.errors.zeros(), noise)
+        from zerocal_sym.design.terms import design_params
+
+        ex = _Exact(robot, T.theta, readings, design_params(robot), robot.errors.zeros(), noise)
     except Exception:  # noqa: BLE001 - no exact model: the first order stands
         return out
     perms = [pi for _, _, pi in pw.order_permutations(K)]
