@@ -64,6 +64,9 @@ def add_arguments(p):
                    help="the size of the one bad reading a design is judged against, mm")
     p.add_argument("--fit-alpha", type=float, default=pw.DEFAULT_ALPHA, metavar="A",
                    help="the level of the fit check a design is judged with (identify's)")
+    p.add_argument("--require-entries", action="store_true",
+                   help="a checked design must also see each robot-file entry at its tolerance that would move an "
+                        "offset by a standard deviation (reported only, by default)")
     p.add_argument("--target-crlb", type=float, default=None, metavar="X",
                    help="the fewest poses whose design reaches this RMS zero-offset CRLB, in the joints' unit: deg "
                         "for revolute, mm for prismatic joints; the region and constraint options apply")
@@ -173,7 +176,8 @@ def tolerances_from_args(robot, args):
 
 
 def requirement_from_args(robot, args, tolerances):
-    """:class:`zerocal_sym.design.detection.Requirement` from ``--power``, ``--bad-reading-mm``, ``--fit-alpha``."""
+    """:class:`zerocal_sym.design.detection.Requirement` from ``--power``, ``--bad-reading-mm``, ``--fit-alpha``,
+    ``--require-entries``."""
     from zerocal_sym.design import power as pw
     from zerocal_sym.design.detection import Requirement
 
@@ -183,7 +187,8 @@ def requirement_from_args(robot, args, tolerances):
 
     return Requirement(robot, tolerances, alpha=get("fit_alpha", pw.DEFAULT_ALPHA),
                        target=get("power", pw.DEFAULT_POWER), bad_reading_mm=get("bad_reading_mm",
-                                                                                 pw.DEFAULT_BAD_READING_MM))
+                                                                                 pw.DEFAULT_BAD_READING_MM),
+                       entries=bool(getattr(args, "require_entries", False)))
 
 
 def _fmt(v, spec=".4g"):
@@ -487,8 +492,9 @@ def _print_detection(out, ju):
         print(f"  {name}: {verdict}")
     inv = d.get("invisible_entries")
     print(f"  (required: power >= {d['power_target']:g} against every order error, and against the scale error and "
-          f"a bad reading unless it moves no offset by {d['harm_sigma']:g} sigma ({d['harm_counted_in']}); a "
-          "single entry at its tolerance is reported, not required"
+          f"a bad reading unless it moves no offset by {d['harm_sigma']:g} sigma ({d['harm_counted_in']}); "
+          + ("each entry at its tolerance likewise (--require-entries)" if d.get("entries_required") else
+             "a single entry at its tolerance is reported, not required (--require-entries)")
           + (f"; no design sees {', '.join(inv)}" if inv else "") + ")")
     c = out.get("checked")
     if c:

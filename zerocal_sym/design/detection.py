@@ -281,7 +281,7 @@ def detection(robot, P, noise=None, requirement: Requirement | None = None, tole
     unmet = [r["name"] for r in rows if r["required"] and not r["met"]]
     out = {"alpha": req.alpha, "dof": dof, "critical_chi2": x, "power_target": req.target,
            "noncentrality_required": lam_req, "harm_sigma": req.harm_sigma,
-           "harm_counted_in": f"{req.sigma_from} standard deviations",
+           "harm_counted_in": f"{req.sigma_from} standard deviations", "entries_required": req.entries,
            "power": _smallest(rows, req), "meets": dof > 0 and not unmet, "unmet": unmet,
            "invisible_entries": list(req.invisible or ()),
            "scenarios": rows if K <= LIST_ALL_MAX_K else _worst_rows(rows),
