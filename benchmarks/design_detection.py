@@ -7,10 +7,10 @@ MAEMM (1, 0.5) mm, seeds 0..N-1: whether the identification is refused (the fit 
 and how far its offsets are from the truth in their reported standard deviations.  The same simulation as
 ``tests/test_design_detection.py``.  Then what the single robot-file entries at their tolerances do: the
 largest non-centrality and harm of an entry for the paper's scheme at K = 6, 20, 100; and the linear
-Delta's K = 12 crlb design, and its checked design when the entries are required too
-(``Requirement(entries=True)``, not the default).
+Delta's and the rotary Delta's K = 12 crlb designs, and their checked designs when the entries are required
+too (``Requirement(entries=True)``, ``--require-entries``; not the default).
 
-Usage: python benchmarks/design_detection.py [--seeds 5] [--no-entries]
+Usage: python benchmarks/design_detection.py [--seeds 5] [--no-entries | --only-entries]
 """
 import argparse
 import math
@@ -49,8 +49,12 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--no-entries", action="store_true", help="skip the single entries' part")
+    ap.add_argument("--only-entries", action="store_true", help="only the single entries' part")
     a = ap.parse_args()
     robot = paper_robot()
+    if a.only_entries:
+        entries(robot)
+        return
     truth = np.degrees([TRUTH["theta1"], TRUTH["theta2"]])
     for crit in ("crlb", "checked"):
         res = design.optimize_design(robot, 6, crit, seed=0)
@@ -85,18 +89,19 @@ def entries(robot):
               f"{max(r['noncentrality'] for r in rows):.3g}, largest power {max(r['power'] for r in rows):.4f}, "
               f"largest harm {max(r['harm_sigma'] for r in rows):.3f} sigma; seen by no design: "
               f"{', '.join(d['invisible_entries'])}")
-    lin = load_robot(Path(__file__).resolve().parents[1] / "examples" / "linear_delta.toml")
-    ref = design.optimize_design(lin, 12, "crlb", seed=0)
-    d = ref.report["detection"]
-    rows = [r for r in d["scenarios"] if r["kind"] == "entry" and r["name"] != "scale"]
-    worst = max(rows, key=lambda r: r["harm_sigma"])
-    print(f"linear Delta, K = 12, crlb design: CRLB {ref.report['crlb_rms_mm']:.5f} mm; the most harmful entry at its "
-          f"tolerance {worst['name']} ({worst['size']:g} {worst['unit']}): harm {worst['harm_sigma']:.2f} sigma, "
-          f"power {worst['power']:.4f}")
-    res = design.optimize_design(lin, 12, "checked", seed=0, requirement=Requirement(lin, entries=True))
-    d = res.report["detection"]
-    print(f"linear Delta, K = 12, checked with the entries required: CRLB {res.report['crlb_rms_mm']:.5f} mm "
-          f"({res.checked['cost']:.2f} x); {'meets it' if d['meets'] else 'misses ' + ', '.join(d['unmet'])}")
+    for name in ("linear_delta", "delta"):
+        rob = load_robot(Path(__file__).resolve().parents[1] / "examples" / f"{name}.toml")
+        ref = design.optimize_design(rob, 12, "crlb", seed=0)
+        d = ref.report["detection"]
+        rows = [r for r in d["scenarios"] if r["kind"] == "entry" and r["name"] != "scale"]
+        worst = max(rows, key=lambda r: r["harm_sigma"])
+        print(f"{rob.name}, K = 12, crlb design: CRLB {ref.report['criterion']['value']:.5g}; the most harmful "
+              f"entry at its tolerance {worst['name']} ({worst['size']:g} {worst['unit']}): harm "
+              f"{worst['harm_sigma']:.2f} sigma, power {worst['power']:.4f}")
+        res = design.optimize_design(rob, 12, "checked", seed=0, requirement=Requirement(rob, entries=True))
+        d = res.report["detection"]
+        print(f"{rob.name}, K = 12, checked with the entries required: CRLB {res.report['criterion']['value']:.5g} "
+              f"({res.checked['cost']:.2f} x); {'meets it' if d['meets'] else 'misses ' + ', '.join(d['unmet'])}")
 
 
 def _f(v):
