@@ -81,7 +81,7 @@ def test_design_optimize_shows_progress_on_a_terminal_only(monkeypatch):
 
     tty = Tty()
     monkeypatch.setattr("sys.stderr", tty)
-    assert main(["design", "--optimize", "--K", "5", "--starts", "1", "--json"]) == 0
+    assert main(["design", "--optimize", "--K", "5", "--criterion", "crlb", "--starts", "1", "--json"]) == 0
     monkeypatch.undo()
     bar = tty.getvalue()
     steps = 1 + 1 + 1 + 1 + 2  # the certificate's approximate design, one exchange start, the scheme and one random
