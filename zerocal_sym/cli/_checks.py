@@ -46,10 +46,12 @@ MAEMM_PRIOR_LIMIT_MM = 1000.0
 DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
                         "joint_limits", "joint_limits_deg", "joint_limits_mm", "min_separation", "noise", "starts",
                         "workers", "scheduler",
-                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
+                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale", "bias_model",
+                        "power", "bad_reading_mm", "fit_alpha", "require_entries")
 #: design --target-crlb X: what it takes besides the region and constraint options (it chooses K, crlb)
 DESIGN_TARGET_NOT = ("K", "criterion", "seed", "verify", "plot", "starts", "workers", "scheduler", "method",
-                     "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
+                     "tolerance", "tolerance_file", "tolerance_scale", "bias_model", "power", "bad_reading_mm",
+                     "fit_alpha", "require_entries")
 #: design options of the boundary scheme, not --optimize
 DESIGN_SCHEME_ONLY = ("n", "eps0", "maemm_prior")
 
