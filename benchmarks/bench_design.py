@@ -1,133 +1,233 @@
-"""Design time of `zerocal design --optimize` for K = 6 and K = 20, and the extra cases (regions, approximate designs).
+"""Design time of `zerocal design --optimize`: the full design against its parts, and the reachable-region case.
 
-For each K and criterion, times the full design (discrete exchange + Ipopt
-multi-start + order search + polish, :func:`zerocal_sym.design.optimize_design`)
-and, as baselines measured in the same run, one Ipopt start (NLP build + one
-solve from the paper's scheme) and the discrete exchange alone; prints the
-ratios, the stage breakdown and what the design achieved.
+Every comparison is timed interleaved (each pass runs every column once, the order rotating from pass to
+pass: benchmarks/_harness.py), CPU time (this process) beside wall time, the load average printed.
 
-The extra cases (printed after the table; ``--only-extras`` skips the table): the K = 6 crlb design over
-the reachable set of the paper's robot with y >= 450 mm, the 350 mm travel limit and the default margin (its
-CRLB, the certified bound, the baseline); K = 100 designs (the approximate method: the exact one took
-1207 s at K = 100 before the approximate design existed) on the paper's robot and the Delta;
-``zerocal design --target-crlb 0.04`` in the paper's workspace (the fewest K and its certified lower bound);
-each with its wall time.
+* table (``--K``, ``--criteria``; the paper's robot, its workspace): the full design
+  (:func:`zerocal_sym.design.optimize_design`: the approximate design's certificate, the discrete exchange,
+  Ipopt multi-start, order search, polish) against one Ipopt start (NLP build + one solve from the paper's
+  scheme) and the discrete exchange alone, with the stage breakdown of the design and what it achieved;
+* reachable (the case of the target): ``zerocal design --optimize --K 6 --criterion crlb --region reachable
+  --bounds -2000 2000 450 2000`` in this process (the region built once, outside the timing), against one
+  Ipopt start of the same NLP; the CPU seconds of each stage (the certificate's approximate design, the
+  exchange, the Ipopt starts and polish) and Ipopt's own split (its function evaluations against the rest).
+  Target: under 1 s of CPU;
+* extras (``--no-extras`` skips them): K = 100 designs (the approximate method) on the paper's robot and the
+  Delta, and ``--target-crlb 0.04`` (the fewest poses): one run each, CPU and wall.
 
-Usage: python benchmarks/bench_design.py [--repeat N] [--K 6 20] [--criteria crlb cond] [--starts 8]
-                                         [--only-extras] [--no-extras]
+Usage: python benchmarks/bench_design.py [--passes 3] [--K 6 20] [--criteria crlb cond] [--starts 8]
+                                         [--only-extras] [--no-extras] [--json]
 """
 import argparse
-import statistics
 import time
 
+from _harness import emit, interleaved, load, load_line, median, ratio, summary
+
+TARGET_CPU_S = 1.0
 
 
-from zerocal_sym import design
-from zerocal_sym.design import nlp as design_nlp
-from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.model.robot import paper_robot
+def stage_clock(mods):
+    """Wrap the stages of optimize_design to add up their CPU seconds (and Ipopt's evaluation times)."""
+    import numpy as np  # noqa: F401
+
+    from zerocal_sym.design import nlp as nlp_mod
+    from zerocal_sym.design import optimize as opt
+
+    acc = {}
+
+    def wrap(mod, name, key):
+        f = getattr(mod, name)
+
+        def g(*a, **k):
+            t = time.process_time()
+            try:
+                return f(*a, **k)
+            finally:
+                acc[key] = acc.get(key, 0.0) + time.process_time() - t
+        setattr(mod, name, g)
+
+    for name, key in (("approximate_design", "certificate (approximate design)"), ("exchange_design", "exchange"),
+                      ("continuous_design", "Ipopt multi-start"), ("best_order", "order search"),
+                      ("evaluate", "report")):
+        if hasattr(opt, name):
+            wrap(opt, name, key)
+    import zerocal_sym.design.approx as approx_mod
+    wrap(approx_mod, "approximate_design", "certificate (approximate design)")
+    solve = nlp_mod._NLP.solve
+
+    def counted(self, P0):
+        t = time.process_time()
+        try:
+            return solve(self, P0)
+        finally:
+            acc["Ipopt solves"] = acc.get("Ipopt solves", 0.0) + time.process_time() - t
+            acc["Ipopt starts"] = acc.get("Ipopt starts", 0) + 1
+            st = self.solver.stats()
+            acc["Ipopt evaluations"] = acc.get("Ipopt evaluations", 0.0) + sum(
+                v for k, v in st.items() if k.startswith("t_proc_nlp"))
+            acc["Ipopt iterations"] = acc.get("Ipopt iterations", 0) + int(st.get("iter_count", 0))
+    nlp_mod._NLP.solve = counted
+    return acc
 
 
-def timed(fn, repeat):
-    times, out = [], None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), out
-
-
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--K", type=int, nargs="+", default=[6, 20])
-    ap.add_argument("--criteria", nargs="+", default=["crlb", "cond"])
-    ap.add_argument("--starts", type=int, default=8)
-    ap.add_argument("--only-extras", action="store_true",
-                    help="only the extra cases (reachable set, approximate designs, fewest poses)")
-    ap.add_argument("--no-extras", action="store_true",
-                    help="skip the extra cases")
-    a = ap.parse_args()
-    if not a.only_extras:
-        table(a)
-    if not a.no_extras:
-        extras()
-
-
-def extras():
-    from zerocal_sym.design import approx
-    from zerocal_sym.model.robot import load_robot
-    from pathlib import Path
+def reachable(passes):
+    from zerocal_sym import design
+    from zerocal_sym.design import nlp as design_nlp
+    from zerocal_sym.model.noise import NoiseModel
+    from zerocal_sym.model.robot import paper_robot
 
     robot, noise = paper_robot(), NoiseModel.paper()
-    print()
-    print("extras (paper noise, default margin, l0 = 350 mm range, seed 0, 8 + 8 starts on the exact path)")
-    t = time.perf_counter()
-    cons = design.make_constraints(robot, region="reachable", bounds=(-float("inf"), float("inf"), 450,
-                                                                       float("inf")))
-    t_region = time.perf_counter() - t
-    t = time.perf_counter()
-    res = design.optimize_design(robot, 6, "crlb", cons, noise, seed=0)
-    d = res.to_dict()
-    print(f"reachable set, y >= 450 mm, K = 6, crlb: CRLB {d['crlb_rms_deg']:.5f} deg per offset "
-          f"{[round(v, 5) for v in d['crlb_zero_offsets_deg']]}; certified bound {d['certificate']['bound']:.5f} deg "
-          f"(efficiency >= {d['certificate']['efficiency_lower_bound']:.3f}); baseline {d['baseline_scheme']} "
-          f"{d['paper']['crlb_rms_deg']:.4f} deg; bias worst/RMS {max(d['bias']['worst_case_deg']):.4f}/"
-          f"{max(d['bias']['rms_deg']):.4f} deg; rho span {d['rho_span_mm']:.1f} mm; region {t_region:.2f} s, "
-          f"design {time.perf_counter() - t:.2f} s ({d['method']})")
-    print("    poses (mm): " + "; ".join(f"({x:.1f}, {y:.1f})" for x, y in res.poses))
-    for label, rob in (("paper", robot), ("delta", load_robot(Path(__file__).resolve().parents[1] / "examples"
-                                                                  / "delta.toml"))):
-        for crit in ("crlb", "D"):
-            t = time.perf_counter()
-            res = design.optimize_design(rob, 100, crit, None, noise, seed=0)
-            td = time.perf_counter() - t
-            d = res.to_dict()
-            c = d["certificate"]
-            print(f"K = 100, {label}, {crit}: {td:.2f} s ({d['method']}); {crit} {d['criterion']['value']:.5g}, "
-                  f"bound {c['bound']:.5g}, efficiency >= {c['efficiency_lower_bound']:.3f}; CRLB "
-                  f"{d['crlb_rms_deg']:.5f} deg vs {d['baseline_scheme']} {d['paper']['crlb_rms_deg']:.4f}")
-    t = time.perf_counter()
-    out = approx.fewest_poses(robot, 0.04, design.make_constraints(robot), noise)
-    print(f"--target-crlb 0.04 (paper workspace): K = {out['K']} (CRLB {out['crlb_rms_deg']:.5f} deg), certified "
-          f"lower bound {out['K_lower_bound']}; {time.perf_counter() - t:.2f} s")
-    t = time.perf_counter()
-    out = approx.fewest_poses(robot, 0.04, design.make_constraints(robot, min_separation_mm=0.1), noise)
-    print(f"--target-crlb 0.04 --min-separation 0.1: K = {out['K']} (CRLB {out['crlb_rms_deg']:.5f} deg), "
-          f"lower bound {out['K_lower_bound']}; {time.perf_counter() - t:.2f} s")
+    t = time.process_time()
+    cons = design.make_constraints(robot, region="reachable", bounds=(-2000, 2000, 450, 2000))
+    region_cpu = time.process_time() - t
+    acc = stage_clock(None)
+    out = {}
+
+    def full():
+        acc.clear()
+        out["res"] = design.optimize_design(robot, 6, "crlb", cons, noise, seed=0)
+        out["stages"] = dict(acc)
+        return 1
+
+    base = design.choose_baseline(robot, 6, cons)[0]
+
+    def one_ipopt():
+        fs, ms = design_nlp._scales(robot, base, noise)
+        design_nlp._NLP(robot, 6, "crlb", cons, noise, fs, ms).solve(base)
+        return 1
+
+    t = interleaved({"design": full, "1 Ipopt start": one_ipopt}, passes)
+    d = out["res"].to_dict()
+    cpu = median(t, "design")
+    return {"columns": summary(t, "s"), "design_cpu_s": cpu, "design_wall_s": median(t, "design", "wall"),
+            "design_over_one_ipopt_cpu": ratio(t, "design", "1 Ipopt start"), "region_cpu_s": region_cpu,
+            "stages_cpu_s": out["stages"], "target_cpu_s": TARGET_CPU_S, "met": cpu < TARGET_CPU_S,
+            "crlb_rms_deg": d["crlb_rms_deg"], "crlb_zero_offsets_deg": d["crlb_zero_offsets_deg"],
+            "baseline_scheme": d["baseline_scheme"], "baseline_crlb_rms_deg": d["paper"]["crlb_rms_deg"],
+            "certificate_bound_deg": d["certificate"]["bound"],
+            "efficiency_lower_bound": d["certificate"]["efficiency_lower_bound"],
+            "bias_worst_deg": max(d["bias"]["worst_case_deg"]), "bias_rms_deg": max(d["bias"]["rms_deg"]),
+            "rho_span_mm": d["rho_span_mm"], "poses_mm": [list(map(float, p)) for p in out["res"].poses],
+            "method": d["method"]}
 
 
 def table(a):
+    from zerocal_sym import design
+    from zerocal_sym.design import nlp as design_nlp
+    from zerocal_sym.model.noise import NoiseModel
+    from zerocal_sym.model.robot import paper_robot
+
     robot = paper_robot()
     noise = NoiseModel.paper()
     cons = design.make_constraints(robot)
     design.pose_terms(robot, robot.workspace_grid(3, 3))  # warm the CasADi function cache
-    print(f"paper robot, workspace, paper noise, {a.starts} random Ipopt starts + {a.starts} exchange starts, "
-          f"median of {a.repeat}")
-    hdr = (f"{'K':>3} {'crit':>5} {'design [s]':>10} {'1 Ipopt [s]':>11} {'x 1 Ipopt':>9} {'exchange [s]':>12} "
-           f"{'x exch.':>8} | {'exch/cont/ord+pol [s]':>22} | {'value':>9} {'paper':>9} {'CRLB ratio':>10}")
-    print(hdr)
+    rows = []
     for K in a.K:
         base = design.paper_baseline(robot, K)
         for crit in a.criteria:
+            out = {}
+
             def one_ipopt():
                 fs, ms = design_nlp._scales(robot, base, noise)
-                nlp = design_nlp._NLP(robot, K, crit, cons, noise, fs, ms)
-                return nlp.solve(base)
+                design_nlp._NLP(robot, K, crit, cons, noise, fs, ms).solve(base)
+                return 1
 
-            t1, _ = timed(one_ipopt, a.repeat)
-            tx, _ = timed(lambda: design.exchange_design(robot, K, crit, cons, noise, 0, a.starts), a.repeat)
-            td, res = timed(lambda: design.optimize_design(robot, K, crit, cons, noise, seed=0, n_starts=a.starts,
-                                                           exchange_starts=a.starts), a.repeat)
-            d = res.to_dict()
-            tm = res.timing
-            stages = f"{tm['exchange']:.2f}/{tm['continuous']:.2f}/{tm['order_polish']:.2f}"
-            print(f"{K:3d} {crit:>5} {td:10.2f} {t1:11.3f} {td / t1:9.1f} {tx:12.2f} {td / tx:8.1f} | {stages:>22} | "
-                  f"{d['criterion']['value']:9.4g} {d['paper']['criterion']['value']:9.4g} "
-                  f"{d['ratio']['crlb_rms_design_over_paper']:10.4f}")
-    print("columns: design = full optimize_design; 1 Ipopt = NLP build + one solve from the paper's scheme; "
-          "exchange = the discrete exchange alone; value/paper = the criterion of the design and of the "
-          "paper's scheme; CRLB ratio = RMS zero-offset CRLB design / paper")
+            def exchange():
+                design.exchange_design(robot, K, crit, cons, noise, 0, a.starts)
+                return 1
+
+            def full():
+                out["res"] = design.optimize_design(robot, K, crit, cons, noise, seed=0, n_starts=a.starts,
+                                                    exchange_starts=a.starts)
+                return 1
+
+            t = interleaved({"design": full, "1 Ipopt start": one_ipopt, "exchange": exchange}, a.passes)
+            d = out["res"].to_dict()
+            rows.append({"K": K, "criterion": crit, "columns": summary(t, "s"),
+                         "design_over_one_ipopt_cpu": ratio(t, "design", "1 Ipopt start"),
+                         "design_over_exchange_cpu": ratio(t, "design", "exchange"),
+                         "stages_wall_s": out["res"].timing, "value": d["criterion"]["value"],
+                         "paper_value": d["paper"]["criterion"]["value"],
+                         "crlb_ratio": d["ratio"]["crlb_rms_design_over_paper"]})
+    return rows
+
+
+def extras():
+    from pathlib import Path
+
+    from zerocal_sym import design
+    from zerocal_sym.design import approx
+    from zerocal_sym.model.noise import NoiseModel
+    from zerocal_sym.model.robot import load_robot, paper_robot
+
+    robot, noise = paper_robot(), NoiseModel.paper()
+    out = []
+
+    def timed(label, fn):
+        c, w = time.process_time(), time.perf_counter()
+        info = fn()
+        out.append({"case": label, "cpu_s": time.process_time() - c, "wall_s": time.perf_counter() - w, **info})
+
+    delta = load_robot(Path(__file__).resolve().parents[1] / "examples" / "delta.toml")
+    for label, rob in (("paper", robot), ("delta", delta)):
+        for crit in ("crlb", "D"):
+            def run(rob=rob, crit=crit):
+                d = design.optimize_design(rob, 100, crit, None, noise, seed=0).to_dict()
+                return {"method": d["method"], "value": d["criterion"]["value"], "bound": d["certificate"]["bound"],
+                        "efficiency_lower_bound": d["certificate"]["efficiency_lower_bound"]}
+            timed(f"K = 100, {label}, {crit}", run)
+    timed("--target-crlb 0.04 (paper workspace)",
+          lambda: {k: v for k, v in approx.fewest_poses(robot, 0.04, design.make_constraints(robot), noise).items()
+                   if k in ("K", "K_lower_bound", "crlb_rms_deg")})
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--passes", "--repeat", dest="passes", type=int, default=3, help="interleaved passes (default 3)")
+    ap.add_argument("--K", type=int, nargs="+", default=[6, 20])
+    ap.add_argument("--criteria", nargs="+", default=["crlb", "cond"])
+    ap.add_argument("--starts", type=int, default=8)
+    ap.add_argument("--only-extras", dest="only_extras", action="store_true",
+                    help="only the reachable case and the extra cases")
+    ap.add_argument("--no-extras", dest="no_extras", action="store_true",
+                    help="skip the extra cases (K = 100, fewest poses)")
+    ap.add_argument("--json", action="store_true", help="print the figures as JSON")
+    a = ap.parse_args()
+    res = {"load_before": load(), "passes": a.passes}
+    res["reachable_K6"] = reachable(a.passes)
+    if not a.only_extras:
+        res["table"] = table(a)
+    if not a.no_extras:
+        res["extras"] = extras()
+    res["load_after"] = load()
+    if emit(res, a.json):
+        return
+    r = res["reachable_K6"]
+    print(f"columns interleaved, {a.passes} passes; CPU time (this process), wall time in brackets")
+    print(f"reachable region, y >= 450 mm, K = 6, crlb: design {r['design_cpu_s']:.2f} s CPU ({r['design_wall_s']:.2f} s "
+          f"wall; target < {TARGET_CPU_S} s CPU: {'met' if r['met'] else 'NOT met'}), {r['design_over_one_ipopt_cpu']:.1f} "
+          f"x one Ipopt start; region {r['region_cpu_s']:.2f} s CPU (outside); CRLB {r['crlb_rms_deg']:.5f} deg "
+          f"per offset {[round(v, 5) for v in r['crlb_zero_offsets_deg']]}; baseline {r['baseline_scheme']} "
+          f"{r['baseline_crlb_rms_deg']:.4f}; certified bound {r['certificate_bound_deg']:.5f}, efficiency >= "
+          f"{r['efficiency_lower_bound']:.3f}; bias worst/RMS {r['bias_worst_deg']:.4f}/{r['bias_rms_deg']:.4f} deg; "
+          f"rho span {r['rho_span_mm']:.1f} mm; {r['method']})")
+    print("  poses (mm): " + "; ".join(f"({x:.1f}, {y:.1f})" for x, y in r["poses_mm"]))
+    print("  stages, CPU s: " + ", ".join(f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}"
+                                          for k, v in r["stages_cpu_s"].items()))
+    for row in res.get("table", []):
+        c = row["columns"]
+        print(f"K = {row['K']:3d} {row['criterion']:>5s}: design {c['design']['cpu_s']:.2f} s CPU "
+              f"({c['design']['wall_s']:.2f}), 1 Ipopt start {c['1 Ipopt start']['cpu_s']:.3f} "
+              f"({c['1 Ipopt start']['wall_s']:.3f}), exchange {c['exchange']['cpu_s']:.2f} "
+              f"({c['exchange']['wall_s']:.2f}); design / 1 Ipopt {row['design_over_one_ipopt_cpu']:.1f} x, / exchange "
+              f"{row['design_over_exchange_cpu']:.1f} x; value {row['value']:.4g} (paper {row['paper_value']:.4g}), "
+              f"CRLB ratio {row['crlb_ratio']:.4f}")
+    for e in res.get("extras", []):
+        rest = ", ".join(f"{k} {v:.5g}" if isinstance(v, float) else f"{k} {v}"
+                         for k, v in e.items() if k not in ("case", "cpu_s", "wall_s"))
+        print(f"{e['case']}: {e['cpu_s']:.2f} s CPU ({e['wall_s']:.2f} s wall); {rest}")
+    print(load_line(res["load_before"], res["load_after"]))
 
 
 if __name__ == "__main__":

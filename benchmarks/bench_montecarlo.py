@@ -1,67 +1,57 @@
 """Monte Carlo cost: `zerocal compare` per trial, 1 vs 2 workers, and the study runner's throughput.
 
-Measured in one run (the machine's load average is printed: it is shared):
+Every comparison is timed interleaved (each pass runs every column once, the order rotating from pass to
+pass: benchmarks/_harness.py), CPU time (this process and its worker processes) beside wall time, the load
+average printed:
 
-  compare-1w     the Monte Carlo of `zerocal compare --trials N1` (paper's robot, group 1, all six
-                 methods) in one process, after a warm-up: wall and CPU time per trial, and per
-                 method the time per trial (identifications x time per identification); the
-                 command's start-up (imports, CasADi functions) measured apart.  Target <= 40 ms.
-  compare-2w     the same with workers=2 on N2 trials (default 1000): wall per trial, the
-                 speed-up over compare-1w, CPU per trial (the workers' included), and 10,000
-                 trials extrapolated from it (labelled so; `--full` runs the 10,000).  Target < 5 min.
-  study          the study runner (run_study, as `zerocal study`) on a generated spec (the paper's
-                 robot at K = 6, p = 4; the rotary Delta at K = 12, p = 6; one cell each), one
-                 and two workers: identifications per second of wall time and of CPU time.
-  single         identify_nlls one data set at a time (the path a trial takes without the
-                 batch), identifications per second, for the ratio batch / single.
+  compare        the Monte Carlo of `zerocal compare` (paper's robot, group 1, all six methods) in this
+                 process, start-up excluded, 1 worker on --n1 trials against 2 workers on --n2: CPU and wall
+                 per trial.  Target: <= 5 ms of CPU per trial on one worker.
+  per method     the same with one method at a time (each column runs the trial's first round and that
+                 method): CPU per trial.
+  start-up       the whole command `zerocal compare --trials 2` against `python -c pass` (CPU of the child).
+  10,000 trials  `zerocal compare --trials 10000 --workers 2` next to `--workers 1`, whole commands, one pass
+                 each, interleaved (--full; otherwise extrapolated from the in-process figures, and labelled so).
+  baseline       (--baseline COMMIT) `zerocal compare --trials --n1 --group 1` of that commit's package (its
+                 zerocal_sym/ extracted by `git archive`, on this environment) against this checkout's, whole
+                 commands interleaved: CPU (the child's) and wall, and their ratio.
+  study          the study runner (run_study, as `zerocal study`) on a generated spec (the paper's robot at
+                 K = 6, p = 4; the rotary Delta at K = 12, p = 6; one cell each), one worker against two:
+                 identifications per CPU second and per wall second; and identify_nlls one at a time.
 
-Usage: python benchmarks/bench_montecarlo.py [--n1 200] [--n2 1000] [--full] [--study 20000]
-       [--chunk 2000] [--json]
+Usage: python benchmarks/bench_montecarlo.py [--n1 200] [--n2 1000] [--passes 3] [--full] [--study 20000]
+       [--chunk 2000] [--baseline COMMIT] [--only-baseline] [--json]
 """
 import argparse
-import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from _harness import (commands, cpu_all, cpu_children, emit, interleaved, load, load_line, median, ratio, spread,
+                      summary)
+
 ROOT = Path(__file__).resolve().parents[1]
 ZEROCAL = [sys.executable, "-m", "zerocal_sym"]
+METHODS = ("tsvd-loop", "tsvd", "nlls", "nlls-loop", "nlls-seq", "scipy")
+TARGET_MS = 5.0
 
 
-def cpu_now():
-    """CPU seconds of this process and of its waited-for children (the worker processes)."""
-    ch = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return time.process_time() + ch.ru_utime + ch.ru_stime
-
-
-def compare(trials, workers):
-    """The Monte Carlo of `zerocal compare --group 1` (all methods) in this process (start-up excluded)."""
+def compare_column(trials, workers, methods=METHODS, out=None):
+    """A column: the Monte Carlo of `zerocal compare --group 1` in this process (start-up excluded)."""
     from zerocal_sym.model.robot import paper_robot
     from zerocal_sym.paper.compare import compare as run
 
     robot = paper_robot()
-    run(robot, trials=2)  # warm-up: CasADi functions built
-    c = cpu_now()
-    rep = run(robot, trials=trials, workers=workers)
-    cpu = cpu_now() - c
-    ex = rep["execution"]
-    per_method = {m: r["identifications"] * r["time_per_identification_ms"]
-                  for m, r in rep["groups"]["1"]["methods"].items()}
-    return {"trials": trials, "workers": workers, "run_wall_s": ex["wall_s"],
-            "wall_per_trial_ms": ex["wall_per_trial_ms"], "cpu_per_trial_ms": 1e3 * cpu / trials,
-            "per_method_ms_per_trial": per_method}
 
-
-def compare_cli(trials, workers):
-    """The whole command (start-up included): wall seconds."""
-    t = time.perf_counter()
-    subprocess.run(ZEROCAL + ["compare", "--trials", str(trials), "--group", "1", "--quiet", "--workers",
-                              str(workers)], check=True, capture_output=True, cwd=ROOT)
-    return time.perf_counter() - t
+    def col():
+        rep = run(robot, trials=trials, workers=workers, methods=methods)
+        if out is not None:
+            out[(workers, methods)] = rep
+        return trials
+    return col
 
 
 SPEC = """name = "bench-{label}"
@@ -80,22 +70,23 @@ TRUTHS = {"paper": "theta1 = 2\ntheta2 = -1\nrMx = 1\nrMy = 0.5",
           "delta": "theta1 = 2\ntheta2 = -1\ntheta3 = 0.5\nrMx = 1\nrMy = 0.5\nrMz = -0.5"}
 
 
-def study(label, robot, trials, chunk, workers, tmp):
-    """The study runner in this process (run_study), one cell."""
+def study_column(label, robot, trials, chunk, workers, tmp):
+    """A column: the study runner in this process (run_study), one cell, a fresh directory each pass."""
     from zerocal_sym.cli import study as st
 
     spec = Path(tmp) / f"{label}.toml"
-    spec.write_text(SPEC.format(label=label, trials=trials, chunk=chunk, robot=robot,
-                                truth=TRUTHS[label.split("-")[0]]))
-    c = cpu_now()
-    run = st.run_study(st.load_spec(spec), Path(tmp) / f"{label}-{workers}w", workers=workers)["run"]
-    cpu = cpu_now() - c
-    return {"label": label, "workers": workers, "trials": trials, "chunk": chunk,
-            "identifications_per_s": run["identifications_per_s"], "run_wall_s": run["wall_s"],
-            "identifications_per_cpu_s": trials / cpu}
+    spec.write_text(SPEC.format(label=label, trials=trials, chunk=chunk, robot=robot, truth=TRUTHS[label]))
+    runs = [0]
+
+    def col():
+        runs[0] += 1
+        st.run_study(st.load_spec(spec), Path(tmp) / f"{label}-{workers}w-{runs[0]}", workers=workers)
+        return trials
+    return col
 
 
-def single(label, robot_path, n=200):
+def single_column(label, robot_path, n=200):
+    """A column: identify_nlls one data set at a time (the path of a trial without the batch)."""
     import numpy as np
 
     from zerocal_sym.cli._common import scheme_poses
@@ -113,77 +104,155 @@ def single(label, robot_path, n=200):
     plant, noise = VirtualPlant(robot, truth), NoiseModel.paper()
     rng = np.random.default_rng(0)
     data = [Measurements(th, plant.measure(th, noise, rng)) for _ in range(n)]
-    identify_nlls(robot, data[0], "paper", noise=noise)
-    t = time.perf_counter()
-    for m in data:
-        identify_nlls(robot, m, "paper", noise=noise)
-    return n / (time.perf_counter() - t)
+
+    def col():
+        for m in data:
+            identify_nlls(robot, m, "paper", noise=noise)
+        return n
+    return col
+
+
+def baseline(commit, trials, passes):
+    """`zerocal compare` of ``commit``'s package against this checkout's, whole commands interleaved."""
+    with tempfile.TemporaryDirectory(prefix="bench-mc-") as tmp:
+        arc = subprocess.run(["git", "-C", str(ROOT), "archive", commit, "zerocal_sym"], capture_output=True)
+        if arc.returncode != 0:
+            raise SystemExit(f"git archive {commit}: {arc.stderr.decode().strip()}")
+        subprocess.run(["tar", "-x", "-C", tmp], input=arc.stdout, check=True)
+        argv = ZEROCAL + ["compare", "--trials", str(trials), "--group", "1", "--quiet"]
+
+        def col(pythonpath):
+            env = dict(os.environ, PYTHONPATH=pythonpath) if pythonpath else dict(os.environ)
+
+            def run():
+                subprocess.run(argv, check=True, capture_output=True, env=env, cwd=ROOT if not pythonpath else tmp)
+                return trials
+            return run
+
+        t = interleaved({f"baseline {commit}": col(tmp), "current": col(None)}, passes, clock=cpu_children)
+    return {"commit": commit, "trials": trials, "columns": summary(t),
+            "cpu_ratio_baseline_over_current": ratio(t, f"baseline {commit}", "current"),
+            "cpu_ratio_spread": spread(t, f"baseline {commit}", "current")}
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n1", type=int, default=200, help="trials of the one-worker compare (default 200)")
     ap.add_argument("--n2", type=int, default=1000, help="trials of the two-worker compare (default 1000)")
-    ap.add_argument("--full", action="store_true", help="run the 10,000-trial compare with --workers 2")
+    ap.add_argument("--passes", type=int, default=3, help="interleaved passes (default 3)")
+    ap.add_argument("--full", action="store_true",
+                    help="run `zerocal compare --trials 10000` with --workers 2 and --workers 1 (minutes)")
     ap.add_argument("--study", type=int, default=20000, help="trials of each study cell (default 20000)")
     ap.add_argument("--chunk", type=int, default=2000, help="trials per study chunk (default 2000)")
+    ap.add_argument("--baseline", metavar="COMMIT", default=None,
+                    help="also time `zerocal compare` of COMMIT's package against this checkout's (interleaved)")
+    ap.add_argument("--only-baseline", action="store_true", help="only the --baseline comparison")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     args = ap.parse_args()
 
     # the compiled tier as a long run uses it; ZEROCAL_COMPILE=always builds the libraries in the warm-ups
     # (cached afterwards), so no build runs inside a timing; ZEROCAL_COMPILE=never measures the interpreted tier
     os.environ.setdefault("ZEROCAL_COMPILE", "always")
-    res = {"load_average_before": os.getloadavg(), "cpus": os.cpu_count(),
-           "compile_mode": os.environ["ZEROCAL_COMPILE"]}
-    res["compare_1w"] = c1 = compare(args.n1, 1)
-    res["compare_cli_startup_s"] = startup = compare_cli(2, 1) - 2 * c1["wall_per_trial_ms"] / 1e3
-    n2 = 10000 if args.full else args.n2
-    res["compare_2w"] = c2 = compare(n2, 2)
-    c2["speedup_over_1w"] = c1["wall_per_trial_ms"] / c2["wall_per_trial_ms"]
-    c2["cpu_ratio_to_1w"] = c2["cpu_per_trial_ms"] / c1["cpu_per_trial_ms"]
-    res["compare_10000_2w_s"] = {"value": (startup + c2["run_wall_s"] if args.full else
-                                           startup + 10000 * c2["wall_per_trial_ms"] / 1e3),
-                                 "measured": bool(args.full),
-                                 "how": ("measured" if args.full else
-                                         f"extrapolated: start-up + 10,000 x the wall per trial of {n2} trials")}
+    res = {"load_before": load(), "compile_mode": os.environ["ZEROCAL_COMPILE"], "passes": args.passes}
+    if args.baseline:
+        res["baseline"] = b = baseline(args.baseline, args.n1, args.passes)
+        if args.only_baseline:
+            res["load_after"] = load()
+            if emit(res, args.json):
+                return
+            print_baseline(b)
+            print(load_line(res["load_before"], res["load_after"]))
+            return
+    reps = {}
+    t = interleaved({"1 worker": compare_column(args.n1, 1, out=reps), "2 workers": compare_column(args.n2, 2)},
+                    args.passes, clock=cpu_all)
+    c1, c2 = median(t, "1 worker"), median(t, "2 workers")
+    res["compare"] = {"n1": args.n1, "n2": args.n2, "columns": summary(t),
+                      "cpu_per_trial_ms_1w": 1e3 * c1, "wall_per_trial_ms_1w": 1e3 * median(t, "1 worker", "wall"),
+                      "cpu_per_trial_ms_2w": 1e3 * c2, "wall_per_trial_ms_2w": 1e3 * median(t, "2 workers", "wall"),
+                      "wall_speedup_2w": ratio(t, "1 worker", "2 workers", "wall"),
+                      "wall_speedup_2w_spread": spread(t, "1 worker", "2 workers", "wall"),
+                      "cpu_ratio_2w_to_1w": ratio(t, "2 workers", "1 worker"),
+                      "target_cpu_ms": TARGET_MS, "met": 1e3 * c1 <= TARGET_MS}
+    rep = reps[(1, METHODS)]["groups"]["1"]["methods"]
+    res["compare"]["identifications_per_trial"] = {m: rep[m]["identifications"] for m in METHODS}
+    tm = interleaved({m: compare_column(args.n1, 1, (m,)) for m in METHODS}, args.passes)
+    res["per_method"] = {m: {"cpu_per_trial_ms": 1e3 * median(tm, m), "wall_per_trial_ms": 1e3 * median(tm, m, "wall")}
+                         for m in METHODS}
+    ts = commands({"zerocal compare --trials 2": ZEROCAL + ["compare", "--trials", "2", "--group", "1", "--quiet"],
+                   "python -c pass": [sys.executable, "-c", "pass"]}, args.passes, cwd=ROOT)
+    res["startup"] = summary(ts, "s")
+    if args.full:
+        cmd = ZEROCAL + ["compare", "--trials", "10000", "--group", "1", "--quiet", "--workers"]
+        tf = commands({"--workers 2": cmd + ["2"], "--workers 1": cmd + ["1"]}, 1, cwd=ROOT)
+        res["compare_10000"] = {"measured": True, **summary(tf, "s")}
+    else:
+        st = res["startup"]["zerocal compare --trials 2"]["wall_s"]
+        res["compare_10000"] = {"measured": False, "how": "extrapolated: start-up + 10,000 x the in-process wall "
+                                                          "per trial",
+                                "--workers 2": {"wall_s": st + 10 * res["compare"]["wall_per_trial_ms_2w"]},
+                                "--workers 1": {"wall_s": st + 10 * res["compare"]["wall_per_trial_ms_1w"]}}
     res["study"] = []
     with tempfile.TemporaryDirectory() as tmp:
         for label, robot in (("paper", "paper"), ("delta", str(ROOT / "examples" / "delta.toml"))):
-            study(label + "-warm", robot, 200, 100, 1, tmp)  # warm-up: the problems built (and compiled)
-            one = study(label, robot, args.study, args.chunk, 1, tmp)
-            two = study(label, robot, args.study, args.chunk, 2, tmp)
-            two["speedup_over_1w"] = two["identifications_per_s"] / one["identifications_per_s"]
-            two["cpu_ratio_to_1w"] = one["identifications_per_cpu_s"] / two["identifications_per_cpu_s"]
-            s1 = single(label, robot)
-            one["single_path_identifications_per_s"] = s1
-            one["batch_over_single"] = one["identifications_per_s"] / s1
-            res["study"] += [one, two]
-    res["load_average_after"] = os.getloadavg()
-    if args.json:
-        print(json.dumps(res, indent=2))
+            cols = {"1 worker": study_column(label, robot, args.study, args.chunk, 1, tmp),
+                    "2 workers": study_column(label, robot, args.study, args.chunk, 2, tmp),
+                    "identify_nlls one at a time": single_column(label, robot)}
+            t = interleaved(cols, args.passes, clock=cpu_all)
+            one, two, single = (median(t, c) for c in cols)
+            res["study"].append({
+                "label": label, "trials": args.study, "chunk": args.chunk, "columns": summary(t),
+                "identifications_per_cpu_s_1w": 1 / one, "identifications_per_cpu_s_2w": 1 / two,
+                "identifications_per_wall_s_1w": 1 / median(t, "1 worker", "wall"),
+                "identifications_per_wall_s_2w": 1 / median(t, "2 workers", "wall"),
+                "single_per_cpu_s": 1 / single,
+                "wall_speedup_2w": ratio(t, "1 worker", "2 workers", "wall"),
+                "cpu_ratio_2w_to_1w": ratio(t, "2 workers", "1 worker"),
+                "batch_over_single_cpu": ratio(t, "identify_nlls one at a time", "1 worker")})
+    res["load_after"] = load()
+    if emit(res, args.json):
         return
-    print(f"machine: {res['cpus']} CPUs, load average before {res['load_average_before'][0]:.2f}, "
-          f"after {res['load_average_after'][0]:.2f} (shared: figures are upper bounds); "
-          f"ZEROCAL_COMPILE={res['compile_mode']}")
-    print(f"compare, 1 worker, {c1['trials']} trials (group 1, all methods): {c1['wall_per_trial_ms']:.1f} ms/trial "
-          f"wall (target <= 40), {c1['cpu_per_trial_ms']:.1f} ms/trial CPU; the command's start-up "
-          f"{res['compare_cli_startup_s']:.1f} s")
-    print("  per method, ms per trial: " + ", ".join(f"{m} {v:.1f}" for m, v in c1["per_method_ms_per_trial"].items()))
-    print(f"compare, 2 workers, {c2['trials']} trials: {c2['wall_per_trial_ms']:.1f} ms/trial wall, speed-up "
-          f"{c2['speedup_over_1w']:.2f} x over 1 worker; CPU per trial (workers included) "
-          f"{c2['cpu_per_trial_ms']:.1f} ms ({c2['cpu_ratio_to_1w']:.2f} x 1 worker's: the work is the same, "
-          "the wall time is what the free cores allow)")
-    t10 = res["compare_10000_2w_s"]
-    print(f"compare, 2 workers, 10,000 trials: {t10['value']:.0f} s = {t10['value'] / 60:.1f} min "
-          f"(target < 5 min; {t10['how']})")
-    for s in res["study"]:
-        extra = (f", speed-up {s['speedup_over_1w']:.2f} x, CPU per identification {s['cpu_ratio_to_1w']:.2f} x 1 "
-                 "worker's" if "speedup_over_1w" in s else
-                 f"; one at a time (identify_nlls) {s['single_path_identifications_per_s']:.0f}/s, "
-                 f"batch/single {s['batch_over_single']:.1f} x")
-        print(f"study {s['label']}, {s['workers']} worker(s), {s['trials']} trials in chunks of {s['chunk']}: "
-              f"{s['identifications_per_s']:.0f} identifications/s ({s['identifications_per_cpu_s']:.0f} per CPU "
-              f"second){extra}")
+    c = res["compare"]
+    print(f"ZEROCAL_COMPILE={res['compile_mode']}; columns interleaved, {args.passes} passes; CPU time (this "
+          "process and its workers) and wall time")
+    print(f"compare, all six methods: 1 worker ({args.n1} trials) {c['cpu_per_trial_ms_1w']:.2f} ms CPU per trial "
+          f"({c['wall_per_trial_ms_1w']:.2f} ms wall; target <= {TARGET_MS} ms CPU: "
+          f"{'met' if c['met'] else 'NOT met'}); 2 workers ({args.n2} trials) {c['cpu_per_trial_ms_2w']:.2f} ms CPU "
+          f"per trial ({c['cpu_ratio_2w_to_1w']:.2f} x one worker's), {c['wall_per_trial_ms_2w']:.2f} ms wall "
+          f"(wall speed-up {c['wall_speedup_2w']:.2f} x)")
+    print("  per method, ms CPU per trial (the first round's simulation included): "
+          + ", ".join(f"{m} {v['cpu_per_trial_ms']:.2f}" for m, v in res["per_method"].items()))
+    print("  identifications per trial: " + ", ".join(f"{m} {v:.2f}" for m, v in c["identifications_per_trial"].items()))
+    s = res["startup"]
+    print(f"start-up: `zerocal compare --trials 2` {s['zerocal compare --trials 2']['cpu_s']:.2f} s CPU "
+          f"({s['zerocal compare --trials 2']['wall_s']:.2f} s wall); python -c pass "
+          f"{s['python -c pass']['cpu_s']:.2f} s CPU")
+    f = res["compare_10000"]
+    how = "measured, whole commands" if f["measured"] else f["how"]
+    print(f"compare --trials 10000: --workers 2 {f['--workers 2']['wall_s']:.0f} s wall"
+          + (f" ({f['--workers 2']['cpu_s']:.0f} s CPU)" if f["measured"] else "")
+          + f", --workers 1 {f['--workers 1']['wall_s']:.0f} s wall"
+          + (f" ({f['--workers 1']['cpu_s']:.0f} s CPU)" if f["measured"] else "") + f" ({how})")
+    for r in res["study"]:
+        print(f"study {r['label']} ({r['trials']} trials, chunks of {r['chunk']}): 1 worker "
+              f"{r['identifications_per_cpu_s_1w']:.0f} identifications per CPU second "
+              f"({r['identifications_per_wall_s_1w']:.0f} per wall second); 2 workers "
+              f"{r['identifications_per_cpu_s_2w']:.0f} per CPU second ({r['identifications_per_wall_s_2w']:.0f} per "
+              f"wall second, speed-up {r['wall_speedup_2w']:.2f} x; CPU {r['cpu_ratio_2w_to_1w']:.2f} x one "
+              f"worker's); identify_nlls one at a time {r['single_per_cpu_s']:.0f} per CPU second (batch "
+              f"{r['batch_over_single_cpu']:.1f} x)")
+    if "baseline" in res:
+        print_baseline(res["baseline"])
+    print(load_line(res["load_before"], res["load_after"]))
+
+
+def print_baseline(b):
+    cols = b["columns"]
+    lo, hi = b["cpu_ratio_spread"]
+    print(f"`zerocal compare --trials {b['trials']} --group 1`, whole commands interleaved: "
+          + ", ".join(f"{n} {c['cpu_ms']:.2f} ms CPU per trial ({c['wall_ms']:.1f} ms wall)" for n, c in cols.items())
+          + f"; the baseline's CPU / this checkout's {b['cpu_ratio_baseline_over_current']:.2f} x (passes {lo:.2f}-{hi:.2f}; "
+          "start-up included)")
 
 
 if __name__ == "__main__":

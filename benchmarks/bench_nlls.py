@@ -4,7 +4,8 @@ Problems: simulated measurement rounds (Table 2 group 1 read literally, the
 paper's noise) of the paper's robot at
   K = 6  -- the paper's six poses (n = 3), 4 parameters;
   K = 42 -- the 42 boundary positions of the paper's Fig. 11, 4 parameters.
-Timed per identification (median over passes of the mean over the rounds):
+Timed per identification, the columns interleaved (each pass runs every column once over the rounds, in
+an order that rotates from pass to pass), CPU time (this process) beside wall time:
 
   identify       identify_nlls as shipped in a loop of identifications: Gauss-Newton
                  in one CasADi call, Ipopt confirms, covariance, rank, the fit
@@ -19,7 +20,7 @@ Timed per identification (median over passes of the mean over the rounds):
                  for the compiled tier; an extra column)
   batch          identify_batch over all rounds at once (per identification)
 
-and the ratios (scipy's time over ours, > 1: ours is faster):
+and the ratios (scipy's CPU time over ours in the same pass, median over the passes; > 1: ours is faster):
 
   x lm           scipy-lm / identify       (the "speedup" asked for)
   x zc           scipy-zc / identify
@@ -27,36 +28,27 @@ and the ratios (scipy's time over ours, > 1: ours is faster):
   x zc-c         scipy-zc-c / identify
 
 and the batched path at scale: N = 10,000 identifications at K = 6 in one
-process (one core).  Ratios are against scipy-lm of the same run; the answers
+process (one core), the compiled and interpreted tiers interleaved.  The answers
 are compared too (max |ours - scipy| over the offsets, deg).
+
+Targets: K = 6 x lm >= 4 and x zc >= 1.2; K = 42 x lm >= 5 and x zc >= 1.2; the same problem's answers
+within 1e-6 deg of scipy's.  The load average is printed with the figures.
 
 With ZEROCAL_COMPILE=never (or no C compiler) the compiled columns are the
 interpreted ones and the header says so.
 
 Usage: python benchmarks/bench_nlls.py [--rounds N] [--repeat R] [--batch N] [--json]
 
---json prints a list with one entry per K (keys K, identify_ms, scipy_lm_ms,
-speedup and the other columns; load_average); the batch-at-scale run is the
-K = 6 entry's "batch_at_scale".
+--json prints {"load_before", "load_after", "rows": one entry per K (K, the CPU medians identify_ms,
+scipy_lm_ms, ..., their wall twins *_wall_ms, the ratios speedup, speedup_zero_copy, ... and their
+per-pass spread, targets and whether they are met), "batch_at_scale"}.
 """
 import argparse
-import json
 import os
-import statistics
 import time
 
 import numpy as np
-
-
-def timed(fn, repeat):
-    """Median over ``repeat`` passes of the mean time per call of fn over its data (after a warm-up)."""
-    fn()
-    out = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        n = fn()
-        out.append((time.perf_counter() - t) / n)
-    return statistics.median(out)
+from _harness import emit, interleaved, load, load_line, median, ratio, spread, summary
 
 
 def positive_int(text):
@@ -73,10 +65,13 @@ def positive_int(text):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rounds", type=positive_int, default=50, help="simulated rounds per K (default 50)")
-    ap.add_argument("--repeat", type=positive_int, default=5, help="timing passes, median reported (default 5)")
+    ap.add_argument("--repeat", type=positive_int, default=15,
+                    help="interleaved timing passes, medians reported (default 15)")
     ap.add_argument("--batch", type=positive_int, default=10000,
                     help="identifications of the batch-at-scale run (default 10000)")
-    ap.add_argument("--json", action="store_true", help="print a JSON list (one entry per K) instead of text")
+    ap.add_argument("--batch-passes", type=positive_int, default=3,
+                    help="interleaved passes of the batch-at-scale run (default 3)")
+    ap.add_argument("--json", action="store_true", help="print JSON instead of text")
     args = ap.parse_args()
 
     from scipy.optimize import least_squares
@@ -93,6 +88,7 @@ def main():
     from zerocal_sym.paper.tables import table2_errors
     from zerocal_sym.report.plots import boundary_positions
 
+    load0 = load()
     robot = paper_robot()
     noise = NoiseModel.paper()
     mode0 = compiled.mode()
@@ -144,29 +140,34 @@ def main():
                 return len(data)
             return f
 
-        t = {"identify": timed(run_identify, args.repeat),
-             "identify-int": timed(lambda: run_identify("interpreted"), args.repeat),
-             "scipy-lm": timed(scipy_runner(False), args.repeat),
-             "scipy-zc": timed(scipy_runner(True), args.repeat),
-             "scipy-zc-c": timed(scipy_runner(True, "compiled"), args.repeat),
-             "batch": timed(run_batch, args.repeat)}
+        cols = {"identify": run_identify, "identify-int": lambda: run_identify("interpreted"),
+                "scipy-lm": scipy_runner(False), "scipy-zc": scipy_runner(True),
+                "scipy-zc-c": scipy_runner(True, "compiled"), "batch": run_batch}
+        t = interleaved(cols, args.repeat)
         use("compiled")
         ours = np.array([r.estimate for r in res["ours"]])
         same = np.array([identify_nlls(robot, m, "paper", noise=noise, reweight=0).estimate for m in data])
         row = {
             "K": K,
-            "identify_ms": 1e3 * t["identify"],
             "compiled": bool(hot.compiled),
             "compile_s": build_s,
-            "identify_interpreted_ms": 1e3 * t["identify-int"],
-            "scipy_lm_zero_copy_compiled_ms": 1e3 * t["scipy-zc-c"],
-            "scipy_lm_ms": 1e3 * t["scipy-lm"],
-            "scipy_lm_zero_copy_ms": 1e3 * t["scipy-zc"],
-            "batch_ms": 1e3 * t["batch"],
-            "speedup": t["scipy-lm"] / t["identify"],
-            "speedup_zero_copy": t["scipy-zc"] / t["identify"],
-            "speedup_interpreted": t["scipy-lm"] / t["identify-int"],
-            "speedup_zero_copy_compiled": t["scipy-zc-c"] / t["identify"],
+            "passes": args.repeat,
+            "rounds": args.rounds,
+            "columns": summary(t),
+        }
+        for col, key in (("identify", "identify_ms"), ("identify-int", "identify_interpreted_ms"),
+                         ("scipy-lm", "scipy_lm_ms"), ("scipy-zc", "scipy_lm_zero_copy_ms"),
+                         ("scipy-zc-c", "scipy_lm_zero_copy_compiled_ms"), ("batch", "batch_ms")):
+            row[key] = 1e3 * median(t, col)
+            row[key.replace("_ms", "_wall_ms")] = 1e3 * median(t, col, "wall")
+        for key, num, den in (("speedup", "scipy-lm", "identify"), ("speedup_zero_copy", "scipy-zc", "identify"),
+                              ("speedup_interpreted", "scipy-lm", "identify-int"),
+                              ("speedup_zero_copy_compiled", "scipy-zc-c", "identify")):
+            row[key] = ratio(t, num, den)
+            row[key + "_spread"] = spread(t, num, den)
+            row[key + "_wall"] = ratio(t, num, den, "wall")
+        target = {6: (4.0, 1.2), 42: (5.0, 1.2)}.get(K)
+        row.update({
             "max_diff_compiled_deg": float(np.max(np.abs(np.degrees(
                 ours[:, :2] - np.array([r.estimate for r in res["ours-int"]])[:, :2])))),
             # the same problem as scipy's (weights held at the start): the answers must agree
@@ -176,7 +177,13 @@ def main():
             "max_diff_batch_deg": float(np.nanmax(np.abs(np.degrees(ours[:, :2] - res["batch"].estimate[:, :2])))),
             "failures": int(sum(not r.success for r in res["ours"])),
             "ipopt_iterations_mean": float(np.mean([r.info["iterations"] for r in res["ours"]])),
-        }
+            "ipopt_solves": int(sum(r.info.get("confirmation") == "ipopt" for r in res["ours"])),
+        })
+        if target:
+            row["target"] = {"speedup": target[0], "speedup_zero_copy": target[1], "answers_deg": 1e-6}
+            row["met"] = {"speedup": row["speedup"] >= target[0],
+                          "speedup_zero_copy": row["speedup_zero_copy"] >= target[1],
+                          "answers": row["max_diff_to_scipy_deg"] <= 1e-6}
         rows.append(row)
     # batch at scale: N identifications of K = 6 in one call sequence, one process, on each tier
     th = kin.ik(robot, paper_poses(robot, 3))
@@ -184,49 +191,72 @@ def main():
     R = np.array([plant.measure(th, noise, rng) for _ in range(args.batch)])
     key = (robot.mechanism_name, 6, tuple(robot.errors.indices("paper")))
     scale_run = {"K": 6, "batch_n": args.batch}
+    probs = {}
     for tier in ("interpreted", "compiled"):
         os.environ["ZEROCAL_COMPILE"] = "never" if tier == "interpreted" else mode0
-        prob = nlls_problem.NllsProblem(robot.mechanism, 6, key[2])
+        probs[tier] = nlls_problem.NllsProblem(robot.mechanism, 6, key[2])
         if tier == "compiled":
-            prob.hot(wait=True)
-        nlls_problem._CACHE[key] = prob
-        identify_batch(robot, th, R[:10], "paper", noise=noise)  # warm-up (builds the mapped Function)
-        t0 = time.perf_counter()
-        b = identify_batch(robot, th, R, "paper", noise=noise)
+            probs[tier].hot(wait=True)
+    out_b = {}
+
+    def scale_runner(tier):
+        def run():
+            os.environ["ZEROCAL_COMPILE"] = "never" if tier == "interpreted" else mode0
+            nlls_problem._CACHE[key] = probs[tier]
+            out_b[tier] = identify_batch(robot, th, R, "paper", noise=noise)
+            return 1
+        return run
+
+    tb = interleaved({"compiled": scale_runner("compiled"), "interpreted": scale_runner("interpreted")},
+                     args.batch_passes)
+    for tier in ("compiled", "interpreted"):
         sfx = "" if tier == "compiled" else "_interpreted"
-        scale_run.update({f"batch_total{sfx}_s": time.perf_counter() - t0,
-                          f"batch_confirmed{sfx}": int(b.confirmed.sum()),
-                          f"batch_success{sfx}": int(b.success.sum())})
-        if tier == "compiled":
-            scale_run["compiled"] = bool(prob.compiled)
-    load = os.getloadavg()[0]
-    if args.json:
-        for r in rows:
-            r["load_average"] = load
-        next(r for r in rows if r["K"] == 6)["batch_at_scale"] = scale_run
-        print(json.dumps(rows, indent=2))
+        b = out_b[tier]
+        scale_run.update({f"batch_total{sfx}_s": median(tb, tier), f"batch_total{sfx}_wall_s": median(tb, tier, "wall"),
+                          f"batch_confirmed{sfx}": int(b.confirmed.sum()), f"batch_success{sfx}": int(b.success.sum())})
+    scale_run["compiled"] = bool(probs["compiled"].compiled)
+    scale_run["passes"] = args.batch_passes
+    os.environ["ZEROCAL_COMPILE"] = mode0
+    load1 = load()
+    if emit({"load_before": load0, "load_after": load1, "rows": rows, "batch_at_scale": scale_run}, args.json):
         return
     mode = "compiled" if all(r["compiled"] for r in rows) else f"NOT compiled ({compiled.status()[-1][2]})"
     print(f"identify and batch on the {mode} tier; identify-int and scipy on the interpreted Functions "
           f"(scipy-zc-c: zero-copy callbacks of the compiled ones)")
-    print("times in ms per identification; ratios = scipy's time / ours (> 1: ours faster), see --help")
-    print(f"{'K':>3s} {'identify':>12s} {'identify-int':>12s} {'scipy-lm':>12s} {'scipy-zc':>12s} "
-          f"{'scipy-zc-c':>11s} {'batch':>9s} {'x lm':>8s} {'x zc':>6s} {'int x lm':>8s} {'x zc-c':>8s}  answers")
+    print(f"columns interleaved, {args.repeat} passes of {args.rounds} rounds; ms per identification, median over "
+          "the passes, CPU time (wall time in brackets); ratios = scipy's CPU time / ours in the same pass "
+          "(> 1: ours faster), see --help")
+    print(f"{'K':>3s} {'identify':>15s} {'identify-int':>15s} {'scipy-lm':>15s} {'scipy-zc':>15s} "
+          f"{'scipy-zc-c':>15s} {'batch':>13s} {'x lm':>6s} {'x zc':>6s} {'int x lm':>8s} {'x zc-c':>6s}")
     for r in rows:
-        print(f"{r['K']:3d} {r['identify_ms']:12.3f} {r['identify_interpreted_ms']:12.3f} {r['scipy_lm_ms']:12.3f} "
-              f"{r['scipy_lm_zero_copy_ms']:12.3f} {r['scipy_lm_zero_copy_compiled_ms']:11.3f} {r['batch_ms']:9.3f} "
-              f"{r['speedup']:8.2f} {r['speedup_zero_copy']:6.2f} {r['speedup_interpreted']:8.2f} "
-              f"{r['speedup_zero_copy_compiled']:8.2f}  "
-              f"same problem: max |ours - scipy| {r['max_diff_to_scipy_deg']:.1e} deg (reweighting moves the "
-              f"answer {r['reweighting_effect_deg']:.1e} deg), |batch - single| "
-              f"{r['max_diff_batch_deg']:.1e} deg, |compiled - interpreted| {r['max_diff_compiled_deg']:.1e} deg, "
-              f"failures {r['failures']}, Ipopt iterations {r['ipopt_iterations_mean']:.1f}, "
-              f"build {r['compile_s']:.1f} s")
-    print(f"batch at scale: {scale_run['batch_n']} identifications at K = 6 (one process): "
-          f"{scale_run['batch_total_s']:.2f} s compiled (confirmed {scale_run['batch_confirmed']}, succeeded "
-          f"{scale_run['batch_success']}), {scale_run['batch_total_interpreted_s']:.2f} s interpreted (confirmed "
-          f"{scale_run['batch_confirmed_interpreted']})")
-    print(f"load average {load:.2f} on {os.cpu_count()} cores")
+        def c(k):
+            return f"{r[k]:6.3f} ({r[k.replace('_ms', '_wall_ms')]:6.3f})"
+        print(f"{r['K']:3d} {c('identify_ms'):>15s} {c('identify_interpreted_ms'):>15s} {c('scipy_lm_ms'):>15s} "
+              f"{c('scipy_lm_zero_copy_ms'):>15s} {c('scipy_lm_zero_copy_compiled_ms'):>15s} {c('batch_ms'):>13s} "
+              f"{r['speedup']:6.2f} {r['speedup_zero_copy']:6.2f} {r['speedup_interpreted']:8.2f} "
+              f"{r['speedup_zero_copy_compiled']:6.2f}")
+    for r in rows:
+        lo, hi = r["speedup_spread"]
+        zlo, zhi = r["speedup_zero_copy_spread"]
+        met = r.get("met", {})
+        tg = r.get("target", {})
+        print(f"K = {r['K']}: x lm {r['speedup']:.2f} (passes {lo:.2f}-{hi:.2f}; target {tg.get('speedup')}: "
+              f"{'met' if met.get('speedup') else 'NOT met'}), x zc {r['speedup_zero_copy']:.2f} (passes "
+              f"{zlo:.2f}-{zhi:.2f}; target {tg.get('speedup_zero_copy')}: "
+              f"{'met' if met.get('speedup_zero_copy') else 'NOT met'}); wall ratios x lm "
+              f"{r['speedup_wall']:.2f}, x zc {r['speedup_zero_copy_wall']:.2f}")
+        print(f"  same problem: max |ours - scipy| {r['max_diff_to_scipy_deg']:.1e} deg (reweighting moves the answer "
+              f"{r['reweighting_effect_deg']:.1e} deg), |batch - single| {r['max_diff_batch_deg']:.1e} deg, "
+              f"|compiled - interpreted| {r['max_diff_compiled_deg']:.1e} deg, failures {r['failures']}, Ipopt "
+              f"solves {r['ipopt_solves']} of {r['rounds']} (iterations {r['ipopt_iterations_mean']:.1f} on "
+              f"average), build {r['compile_s']:.1f} s")
+    print(f"batch at scale: {scale_run['batch_n']} identifications at K = 6 (one process, {scale_run['passes']} "
+          f"interleaved passes): {scale_run['batch_total_s']:.2f} s CPU ({scale_run['batch_total_wall_s']:.2f} s wall) "
+          f"compiled (confirmed {scale_run['batch_confirmed']}, succeeded {scale_run['batch_success']}), "
+          f"{scale_run['batch_total_interpreted_s']:.2f} s CPU ({scale_run['batch_total_interpreted_wall_s']:.2f} s "
+          f"wall) interpreted (confirmed {scale_run['batch_confirmed_interpreted']})")
+    print(load_line(load0, load1))
+
 
 if __name__ == "__main__":
     main()

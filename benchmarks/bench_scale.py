@@ -1,8 +1,8 @@
 """Scale: ``zerocal identify`` at K poses, wall and CPU time and peak memory per K, against K = 1000 of the same run.
 
-For each robot (default the paper's planar robot and ``examples/delta.toml``)
-and K, a measurement file of K random poses in the workspace is simulated
-(paper noise, fixed seed); a *rejected* round has one bad reading (+0.5 mm at
+For each robot (default the paper's planar robot and ``examples/delta.toml``;
+any robot file with ``--robots``) and K, a measurement file of K random poses
+in the workspace is simulated (the robot's noise, fixed seed); a *rejected* round has one bad reading (+0.5 mm at
 pose K/2), which the fit check rejects and diagnoses.  Each
 ``zerocal identify FILE --method M --json`` runs in a fresh process: wall
 time (``time.perf_counter``), CPU time (user + system, from ``os.wait4``) and
@@ -47,10 +47,13 @@ def simulate(path, robot_file, K, bad=False, seed=1):
     lo, hi = robot.workspace.bounds()
     rng = np.random.default_rng(seed)
     P = lo + (hi - lo) * rng.random((4 * K, len(lo)))
-    P = P[robot.workspace.contains(P, -1.0)][:K]
+    inside = robot.workspace.contains(P, -1.0)  # 1 mm inside; a workspace with orientations (rad): inside
+    P = P[inside if inside.sum() >= K else robot.workspace.contains(P, 0.0)][:K]
     e = robot.errors
-    err = e.assemble((0.5, -0.3, 0.2)[: robot.m], None, (0.5, -0.2, 0.1)[: robot.n])
-    meas = simulate_round(robot, VirtualPlant(robot, err), P, None, NoiseModel.paper(), rng)
+    # offsets 0.5, -0.3, 0.2, ... (deg or mm, the joints' unit) and MAEMM 0.5, -0.2, 0.1, ... mm, by name: any mechanism
+    err = e.from_user({**{n: (0.5, -0.3, 0.2)[i % 3] for i, n in enumerate(e.zero_offsets)},
+                       **{n: (0.5, -0.2, 0.1)[i % 3] for i, n in enumerate(e.measuring)}})
+    meas = simulate_round(robot, VirtualPlant(robot, err), P, None, NoiseModel.named("paper", robot), rng)
     if bad:
         meas.readings[K // 2] += BAD_MM
     meas.meta = {"robot_sha256": robot.sha256, "generator": "benchmarks/bench_scale.py"}

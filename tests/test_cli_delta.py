@@ -95,7 +95,8 @@ def test_design_default_scheme_and_table(capsys):
 @pytest.mark.slow
 def test_design_optimize_cylinder(capsys, tmp_path):
     png = tmp_path / "design.png"
-    d = json.loads(zc(capsys, "design", *R, "--optimize", "--K", "8", "--starts", "1", "--plot", png, "--json"))
+    d = json.loads(zc(capsys, "design", *R, "--optimize", "--K", "8", "--starts", "1", "--criterion", "crlb", "--plot",
+                      png, "--json"))
     P = np.array(d["poses"])
     assert d["K"] == 8 and P.shape == (8, 3) and d["baseline"] == "ring"
     assert np.all(np.hypot(P[:, 0], P[:, 1]) <= 200 + 1e-6) and np.all((P[:, 2] >= -900 - 1e-6) & (P[:, 2] <= -700 + 1e-6))

@@ -301,6 +301,26 @@ def test_reachable_k6_design_and_baseline(robot, reach450):
     assert design.check_design(robot, np.array(d["paper"]["poses"]), reach450) == []
 
 
+def test_certificate_is_not_above_a_denser_candidate_set(robot, reach450):
+    """The certificate holds beyond its grid: for the K = 6 design of the reachable set (y >= 450 mm), the
+    efficiency it certifies (with the local maxima of the sensitivity over the region) is not above what a
+    grid of four times the candidates alone gives the same design -- up to the search's tolerance.  The grid
+    alone (the certificate before the search) is above it."""
+    from zerocal_sym.design import certify
+
+    res = design.optimize_design(robot, 6, "crlb", reach450, NOISE, seed=0, n_starts=2, exchange_starts=2)
+    v, cert = res.report["crlb_rms_deg"], res.certificate
+    dense = approx.approximate_design(robot, "crlb", reach450, NOISE, n_candidates=6000, search=False)
+    grid = approx.approximate_design(robot, "crlb", reach450, NOISE, search=False)
+    print(f"efficiency >= {cert['efficiency_lower_bound']:.4f} certified; {dense.efficiency(v, 6):.4f} on "
+          f"{dense.n_candidates} grid poses; {grid.efficiency(v, 6):.4f} (bound {grid.bound(6):.5f} deg) on the "
+          f"{grid.n_candidates} of the grid alone")
+    assert cert["efficiency_lower_bound"] <= dense.efficiency(v, 6) * (1 + certify.REGION_TOL)
+    assert grid.efficiency(v, 6) > dense.efficiency(v, 6)  # what the search corrects
+    assert cert["certificate"] == f"over {cert['n_candidates']} candidates" and cert["region_search"]["added"] > 0
+    assert "the design's 6 poses" in cert["candidates"]
+
+
 def test_baseline_never_singular_or_infeasible(robot):
     """A region whose edges are singular: the rule on them is rejected, the workspace scheme taken."""
     cons = design.make_constraints(robot, region="reachable", bounds=(-700, 700, 450, 800))
@@ -343,8 +363,8 @@ def test_cli_reachable_and_polygon(capsys):
                "--bounds", "open", "open", "450", "open", "--json"])
     d = json.loads(capsys.readouterr().out)
     assert rc == 0 and d["constraints"]["region_kind"] == "reachable" and d["violations"] == []
-    rc = main(["design", "--optimize", "--K", "6", "--starts", "1", "--region", "polygon", "-200", "640", "200",
-               "640", "0", "780"])
+    rc = main(["design", "--optimize", "--K", "6", "--starts", "1", "--criterion", "crlb", "--region", "polygon",
+               "-200", "640", "200", "640", "0", "780"])
     out = capsys.readouterr().out
     assert rc == 0 and "polygon" in out and "certificate" in out
     assert main(["design", "--optimize", "--region", "reachable", "--bounds", "a", "b", "1", "2"]) == 2
@@ -415,7 +435,7 @@ def test_symbolic_objective_new_criteria(robot, ws_cons, criterion):
 def test_bias_aware_design_trades_crlb_for_bias(robot, reach450):
     """Ten times set A: the mse design has a larger CRLB and a smaller RMS error than the crlb design."""
     tol = bias.make_tolerances(robot, scale=10)
-    kw = dict(seed=0, n_starts=2, exchange_starts=2, tolerances=tol)
+    kw = dict(seed=0, n_starts=2, exchange_starts=2, tolerances=tol, certificate=False)
     c = design.optimize_design(robot, 6, "crlb", reach450, NOISE, **kw).to_dict()
     m = design.optimize_design(robot, 6, "mse", reach450, NOISE, **kw).to_dict()
     print(f"crlb design: CRLB {c['crlb_rms_deg']:.5f}, RMS error {c['criterion']['values']['mse']:.5f}; "
@@ -438,7 +458,7 @@ def test_worst_case_bias_model(robot, reach450):
     f, _ = nlp.fg(nlp.x0(Q))  # the epigraph starts at |B| (1 + 1e-6)
     assert float(f) - np.log(fs) == pytest.approx(criteria._objective(robot, "mse", Q, NOISE, tw), abs=1e-5)
     kw = dict(seed=0, n_starts=2, exchange_starts=2)
-    w = design.optimize_design(robot, 6, "mse", reach450, NOISE, tolerances=tw, **kw)
+    w = design.optimize_design(robot, 6, "mse", reach450, NOISE, tolerances=tw, certificate=False, **kw)
     c = design.optimize_design(robot, 6, "crlb", reach450, NOISE, certificate=False, **kw)
     assert w.report["criterion"]["value"] < 0.6 * design.criterion_values(robot, c.poses, NOISE, tw)["mse"]
     with pytest.raises(Exception, match="bias model"):
@@ -479,7 +499,8 @@ def test_delta_reachable_cylinder_bounds(delta):
     assert reg.clip.kind == "cylinder"
     X = reg.grid(300)
     assert np.all(np.hypot(X[:, 0], X[:, 1]) <= 300 + 1e-6)
-    res = design.optimize_design(delta, 8, "crlb", cons, NOISE, seed=0, n_starts=2, exchange_starts=2)
+    res = design.optimize_design(delta, 8, "crlb", cons, NOISE, seed=0, n_starts=2, exchange_starts=2,
+                                 certificate=False)
     assert design.check_design(delta, res.poses, cons) == []
     assert res.to_dict()["baseline_scheme"] == "ring scheme on the workspace"
 

@@ -96,7 +96,9 @@ def test_clean_rounds_pass_with_the_fit_recorded(case):
         assert len(fit["readings"]) == case.th_large.shape[0] - 1 and fit["readings"][0]["pose"] == 1
         assert fit["readings"][0]["from_pose"] == 0 and 0 < fit["readings"][0]["leverage"] < 1
         d = res.to_dict()
-        assert d["std_kind"] == "total" and d["fit"]["chi2"] == pytest.approx(fit["chi2"])
+        # TSVD: a parameter whose linearisation bias is not small and well determined has a bound for its std
+        assert d["std_kind"] in (("total",) if res.method == "nlls" else ("total", "bound"))
+        assert d["fit"]["chi2"] == pytest.approx(fit["chi2"])
         json.dumps(d)  # JSON-ready
 
 
@@ -322,7 +324,10 @@ def test_tsvd_std_covers_its_error(robot, noise_name):
     Z, Zn = [], []
     for _ in range(200):
         res = identify_tsvd(robot, Measurements(th, plant.measure(th, noise, rng)), noise=noise)
-        assert res.std_kind == "total" and res.to_dict()["std_kind"] == "total"
+        kinds = set(res.info["std_kinds"].values())
+        assert res.std_kind == ("bound" if "bound" in kinds else "total") == res.to_dict()["std_kind"]
+        if noise_name == "scale-only":  # the linearisation bias dominates the offsets' std: bounds
+            assert res.info["std_kinds"]["theta1"] == res.info["std_kinds"]["theta2"] == "bound"
         e = res.estimate - robot.errors.take(truth, res.params)
         Z.append(e / np.sqrt(np.diag(res.covariance)))
         Zn.append(e / np.sqrt(np.diag(np.array(res.info["covariance_noise"]))))

@@ -157,9 +157,9 @@ def test_reproduce_out_must_be_a_directory_not_an_input(capsys, tmp_path, files)
     ["identify", ""],
     ["robot", "--robot", ""],
 ])
-def test_empty_file_name_is_an_error(capsys, tmp_path, files, argv):
+def test_empty_file_name_is_an_error(capsys, tmp_path, files, argv, monkeypatch):
     argv = [{"DATA": files["data"], "DATA2": files["data2"], "RESULT": files["result"]}.get(a, a) for a in argv]
-    os.chdir(tmp_path)
+    monkeypatch.chdir(tmp_path)  # restored after the test: the next tests' relative paths are the checkout's
     line = one_line_error(capsys, argv)
     assert "empty" in line
     assert list(tmp_path.iterdir()) == []

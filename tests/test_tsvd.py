@@ -292,3 +292,44 @@ def test_identify_tsvd_many_falls_back_to_one_by_one(robot, monkeypatch):
         RuntimeError("KeyboardInterrupt")))
     with pytest.raises(RuntimeError, match="KeyboardInterrupt"):
         identify_tsvd_many(robot, rounds, priors)
+
+
+def test_identify_tsvd_many_with_noise_gives_the_std_of_one_by_one(robot):
+    """With a noise model the batch gives each round the std identify_tsvd computes for it (the noise at the
+    estimate, the linearisation bias of TSVD's own operator, each parameter's kind), to the round-off of the
+    batched linear algebra; a truncated round is identified alone, its truncation bound included."""
+    from zerocal_sym.identify.tsvd import identify_tsvd_many
+
+    noise = NoiseModel.paper()
+    rounds, priors = _rounds(robot, 6, seed=4)
+    for kw in ({}, {"t": 3}):
+        for a, meas, prior in zip(identify_tsvd_many(robot, rounds, priors, noise=noise, **kw), rounds, priors):
+            b = identify_tsvd(robot, meas, prior, noise=noise, **kw)
+            np.testing.assert_array_equal(a.estimate, b.estimate)
+            scale = np.sqrt(np.outer(np.diag(b.covariance), np.diag(b.covariance)))
+            assert np.max(np.abs(a.covariance - b.covariance) / scale) < 1e-9
+            np.testing.assert_allclose(a.info["linearisation_bias"], b.info["linearisation_bias"], rtol=1e-6,
+                                       atol=1e-9 * np.max(np.sqrt(np.diag(b.covariance))))
+            assert a.std_kind == b.std_kind and a.info["std_kinds"] == b.info["std_kinds"]
+            assert set(b.info["std_kinds"].values()) <= {"total", "bound"}
+            assert b.std_kind == ("bound" if "bound" in b.info["std_kinds"].values() else "total")
+        if kw:  # truncated: the truncated directions' bias bound makes every offset's std a bound
+            assert all(r.info["std_kinds"]["theta1"] == "bound" for r in identify_tsvd_many(robot, rounds, priors,
+                                                                                          noise=noise, **kw))
+
+
+def test_linearisation_bias_is_the_bias_of_tsvds_operator(robot):
+    """Noise-free data: the one-step estimate's error is its linearisation bias, and the bias reported is that
+    error (t* is the truth); an iterated TSVD has none."""
+    from zerocal_sym.paper.tables import group_errors
+
+    truth = robot.errors.put(group_errors(1, "paper"), robot.errors.geometry, 0.0)
+    th = kin.ik(robot, paper_poses(robot, 3))
+    meas = Measurements(th, VirtualPlant(robot, truth).measure(th))
+    one = identify_tsvd(robot, meas, noise=NoiseModel.paper())
+    err = one.estimate - robot.errors.take(truth, one.params)
+    assert np.max(np.abs(np.degrees(err[:2]))) > 0.05  # the paper's one step at 2 deg offsets
+    np.testing.assert_allclose(one.info["linearisation_bias"], err, rtol=1e-6, atol=1e-12)
+    it = identify_tsvd(robot, meas, noise=NoiseModel.paper(), iterations=20)
+    assert it.info["tsvd_converged"] and it.std_kind == "total"
+    assert np.max(np.abs(it.info["linearisation_bias"])) < 1e-9

@@ -73,7 +73,7 @@ def version() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from zerocal_sym.cli._paths import InputFile, path_options
+    from zerocal_sym.cli._paths import ROBOT_FILE, InputFile, path_options
 
     parser = _Parser(
         prog="zerocal",
@@ -83,7 +83,7 @@ def build_parser() -> argparse.ArgumentParser:
     for mod in _command_modules():
         p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.__doc__,
                            formatter_class=_HelpFormatter)
-        p.add_argument("--robot", metavar="FILE", default=None, type=InputFile("the robot file"),
+        p.add_argument("--robot", metavar="FILE", default=None, type=InputFile(ROBOT_FILE),
                        help=getattr(mod, "ROBOT_HELP", ROBOT_HELP))
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run, _paths=path_options(p))  # the files it reads and writes (cli/_paths.py)

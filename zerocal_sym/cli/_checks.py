@@ -36,6 +36,9 @@ from zerocal_sym.errors import ZerocalError
 
 #: the most poses per boundary of a scheme (--n): K = 2n = 100,000 poses
 MAX_N = 50_000
+#: Monte Carlo trials at most of compare (per group) and design --verify: every trial's estimates are held in
+#: memory until the summary; a larger Monte Carlo is a study (chunked on disk, resumable)
+MAX_TRIALS = 1_000_000
 #: a MAEMM prior beyond this is not a manufacturing error of the measuring mechanism (mm)
 MAEMM_PRIOR_LIMIT_MM = 1000.0
 
@@ -43,10 +46,12 @@ MAEMM_PRIOR_LIMIT_MM = 1000.0
 DESIGN_OPTIMIZE_ONLY = ("K", "criterion", "region", "seed", "verify", "plot", "l0", "travel_mode", "margin",
                         "joint_limits", "joint_limits_deg", "joint_limits_mm", "min_separation", "noise", "starts",
                         "workers", "scheduler",
-                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
+                        "bounds", "method", "tolerance", "tolerance_file", "tolerance_scale", "bias_model",
+                        "power", "bad_reading_mm", "fit_alpha", "require_entries")
 #: design --target-crlb X: what it takes besides the region and constraint options (it chooses K, crlb)
 DESIGN_TARGET_NOT = ("K", "criterion", "seed", "verify", "plot", "starts", "workers", "scheduler", "method",
-                     "tolerance", "tolerance_file", "tolerance_scale", "bias_model")
+                     "tolerance", "tolerance_file", "tolerance_scale", "bias_model", "power", "bad_reading_mm",
+                     "fit_alpha", "require_entries")
 #: design options of the boundary scheme, not --optimize
 DESIGN_SCHEME_ONLY = ("n", "eps0", "maemm_prior")
 
@@ -113,7 +118,7 @@ def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
     which, and which gauge-fixing parameters to leave out.  ``poses``: how the
     phrase names the poses (default ``these K poses``).
     """
-    from zerocal_sym.identify.identifiability import identifiability_report
+    from zerocal_sym.identify.identifiability import identifiability_report, null_direction_text
 
     names = list(names)
     K, p = len(theta_cmd), len(names)
@@ -130,12 +135,17 @@ def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
         why = (f"the distances do not see the rigid motion{'s' if len(motions) > 1 else ''} {', '.join(motions)}"
                + (f"; leave {', '.join(fix)} out of the parameters to fix {'them' if len(motions) > 1 else 'it'}"
                   if fix else ""))
+    elif p - r <= 2:  # each null direction by its amounts in file units: what a reader can picture
+        combos = "; ".join(null_direction_text(robot, comb) for comb in rep["null_space"])
+        why = (f"{'this combination changes' if p - r == 1 else 'these combinations change'} no measured distance: "
+               f"{combos}; identify fewer parameters or measure other poses")
     else:
         bad = [n for n, ok in rep["identifiable"].items() if not ok]
-        why = (f"{p - r} unobservable combination{'s' if p - r > 1 else ''} of "
+        why = (f"{p - r} unobservable combinations of "
                + ", ".join(bad[:6]) + (f" and {len(bad) - 6} more" if len(bad) > 6 else "")
                + "; identify fewer parameters or measure other poses")
     return f"the {p} parameters are not identifiable from {poses} (rank {r} of {p}: {why})"
+
 
 
 # --------------------------------------------------------------------------- per command
@@ -244,9 +254,17 @@ def _simulate(args) -> None:
     _n(args)
 
 
+def _trials(args, dest: str, lo: int) -> None:
+    v = getattr(args, dest, None)
+    if v is not None and not lo <= v <= MAX_TRIALS:
+        raise ZerocalError(f"{_opt(dest)} must be {lo}..{MAX_TRIALS:,} (every trial's estimates are held in memory; "
+                           "a larger Monte Carlo is a study, chunked on disk and resumable: zerocal study)")
+
+
 def _compare(args) -> None:
     _seed(args)
     _n(args)
+    _trials(args, "trials", 1)
     methods = [m.strip() for m in str(args.methods).split(",") if m.strip()]
     if not methods:
         raise ZerocalError("--methods: no method given (a comma-separated subset of tsvd-loop, tsvd, nlls, "
@@ -261,7 +279,7 @@ def _compare(args) -> None:
                            f"methods identify the zero offsets and the MAEMM (--methods {','.join(methods)})")
     if args.max_iter is not None and args.max_iter < 1:
         raise ZerocalError(f"--max-iter must be >= 1 (identifications per loop), got {args.max_iter}")
-    _positive(args, "mu0", " of degrees")
+    _positive(args, "mu0", " (in the joints' unit)")
 
 
 def _design(args) -> None:
@@ -285,6 +303,7 @@ def _design(args) -> None:
             raise ZerocalError(f"{_opts(bad)}: where the --verify Monte Carlo runs: give --verify N")
     _seed(args)
     _n(args)
+    _trials(args, "verify", 0)
     _maemm_prior(args)
 
 

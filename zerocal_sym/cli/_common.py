@@ -116,7 +116,7 @@ def poses_arg(robot, spec, n, identifiable: bool = True, allow_revisits: bool = 
     return load_poses(spec, robot, allow_revisits, measured=True), str(spec)
 
 
-def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = False) -> None:
+def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = False, region=None) -> None:
     """Refuse a measurement round (``compensate --template``) that identify would refuse.
 
     The checks of ``zerocal identify`` on the poses themselves: enough poses
@@ -124,7 +124,9 @@ def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = F
     inside the workspace, reachable and away from singular configurations
     (the robot's singularity margin), no pose repeated right after itself
     (nor after other poses, unless ``allow_revisits``), the poses not on one
-    line, and the paper's identification matrix G of full rank.
+    line, and the paper's identification matrix G of full rank.  ``region``:
+    the region a design's poses carry (:func:`zerocal_sym.io.poses.load_design_poses`),
+    whose singularity margin replaces the workspace check.
 
     Raises
     ------
@@ -147,8 +149,9 @@ def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = F
     if K < need:
         raise PoseError(f"{K} poses give {K - 1} measured changes: too few for the {p} parameters ({names}); a "
                         f"measurement round needs at least {need} poses ({why})", where=source)
-    try:
-        theta = kin.check_poses(robot, P, in_workspace=True)
+    try:  # a design's own region (load_design_poses): its margin, not the workspace
+        theta = (kin.check_poses(robot, P, in_workspace=True) if region is None
+                 else kin.check_poses(robot, P, margin=region["region_singularity_margin"]))
     except PoseError as exc:
         raise PoseError(f"{exc.where}: {exc.message} ({why})" if exc.where else f"{exc.message} ({why})",
                         where=source) from None
@@ -175,8 +178,12 @@ def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = F
     G, _ = identification_matrix(robot, P, theta=theta)
     s = np.linalg.svd(G, compute_uv=False)
     if not s[-1] > RANK_RTOL * s[0]:
+        from zerocal_sym.identify.identifiability import null_space_phrase
+
+        null = null_space_phrase(robot, theta, robot.errors.resolve("default"))
         raise PoseError(f"the identification matrix G of these poses has rank {int(np.sum(s > RANK_RTOL * s[0]))} "
-                        f"< {p}: the parameters {names} are not identifiable from them ({why})", where=source)
+                        f"< {p}: the parameters {names} are not identifiable from them"
+                        + (f" ({null})" if null else "") + f" ({why})", where=source)
 
 
 # --------------------------------------------------------------------------- values by name

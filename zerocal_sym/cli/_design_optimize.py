@@ -56,6 +56,17 @@ def add_arguments(p):
     p.add_argument("--bias-model", choices=["rms", "worst"], default="rms",
                    help="how --criterion mse counts the bias: rms (expected, errors uniform within the "
                         "tolerances; default) or worst (the worst case within them)")
+    from zerocal_sym.design import power as pw
+
+    p.add_argument("--power", type=float, default=pw.DEFAULT_POWER, metavar="P",
+                   help="the power the fit check of a checked design keeps against each error it must see")
+    p.add_argument("--bad-reading-mm", type=float, default=pw.DEFAULT_BAD_READING_MM, metavar="MM",
+                   help="the size of the one bad reading a design is judged against, mm")
+    p.add_argument("--fit-alpha", type=float, default=pw.DEFAULT_ALPHA, metavar="A",
+                   help="the level of the fit check a design is judged with (identify's)")
+    p.add_argument("--require-entries", action="store_true",
+                   help="a checked design must also see each robot-file entry at its tolerance that would move an "
+                        "offset by a standard deviation (reported only, by default)")
     p.add_argument("--target-crlb", type=float, default=None, metavar="X",
                    help="the fewest poses whose design reaches this RMS zero-offset CRLB, in the joints' unit: deg "
                         "for revolute, mm for prismatic joints; the region and constraint options apply")
@@ -164,6 +175,22 @@ def tolerances_from_args(robot, args):
                            bias_model=getattr(args, "bias_model", "rms"))
 
 
+def requirement_from_args(robot, args, tolerances):
+    """:class:`zerocal_sym.design.detection.Requirement` from ``--power``, ``--bad-reading-mm``, ``--fit-alpha``,
+    ``--require-entries``."""
+    from zerocal_sym.design import power as pw
+    from zerocal_sym.design.detection import Requirement
+
+    def get(name, default):
+        v = getattr(args, name, None)
+        return default if v is None else v
+
+    return Requirement(robot, tolerances, alpha=get("fit_alpha", pw.DEFAULT_ALPHA),
+                       target=get("power", pw.DEFAULT_POWER), bad_reading_mm=get("bad_reading_mm",
+                                                                                 pw.DEFAULT_BAD_READING_MM),
+                       entries=bool(getattr(args, "require_entries", False)))
+
+
 def _fmt(v, spec=".4g"):
     import math
 
@@ -219,7 +246,7 @@ def run(args, robot):
                                  f"coordinates ({', '.join(robot.mechanism.pose_names)}): use --json")
     K = args.K if args.K is not None else robot.workspace.scheme_size(default_n(robot))
     limits._check_k(K, robot)
-    criteria._check_criterion(args.criterion)
+    criteria._check_criterion(args.criterion, criteria.DESIGN_CRITERIA)
     verify = int(getattr(args, "verify", 0) or 0)
     if verify < 0:
         raise design.DesignError(f"--verify N needs N >= 0, got {verify}")
@@ -245,14 +272,17 @@ def run(args, robot):
 
         if not args.json:
             print(f"choosing the parameter set (approximate designs, K = {K}):", file=sys.stderr)
-        choice = choose_design_params(robot, K, args.criterion, cons, noise, tol, seed=args.seed, starts=starts,
+        crit = "crlb" if args.criterion == criteria.CHECKED else args.criterion  # (the set by the CRLB alone)
+        choice = choose_design_params(robot, K, crit, cons, noise, tol, seed=args.seed, starts=starts,
                                       progress=None if args.json else lambda line: print(line, file=sys.stderr))
         robot = robot.identifying(choice["chosen"])
+    req = requirement_from_args(robot, args, tol)
     ex = _parallel.execution(args) if verify and hasattr(args, "workers") else {}  # a scheduler reached first
     bar = progress_bar()
     try:
         res = design.optimize_design(robot, K, args.criterion, cons, noise, seed=args.seed, n_starts=starts,
-                                     exchange_starts=starts, tolerances=tol, method=method, progress=bar)
+                                     exchange_starts=starts, tolerances=tol, method=method, progress=bar,
+                                     requirement=req)
     except BaseException:
         _parallel.close(ex)
         raise
@@ -390,6 +420,7 @@ def _print_text(out, res, robot):
     if b:
         tol = ", ".join(f"{k_} {v:g}" for k_, v in b["tolerances"].items())
         print(f"  (bias: first order from the tolerances {tol} (mm, deg); RMS for uniform errors)")
+    _print_detection(out, ju)
     print()
     if pp is not None:
         print(f"CRLB ratio design / {out.get('baseline_scheme') or base + ' scheme'} (RMS over the {len(joints)} "
@@ -400,8 +431,9 @@ def _print_text(out, res, robot):
     if cert:
         eff = cert.get("efficiency_lower_bound")
         what = cert["criterion"]
-        print(f"certificate: no {out['K']}-pose design on the {cert['n_candidates']} candidate poses has {what} "
-              f"better than {_fmt(cert['bound'])} {units_.get(what, '')}; this design's efficiency >= "
+        print(f"certificate {cert.get('certificate') or ''}: no {out['K']}-pose design on the "
+              f"{cert['n_candidates']} candidate poses (this design's among them) has {what} better than "
+              f"{_fmt(cert['bound'])} {units_.get(what, '')}; this design's efficiency >= "
               f"{_fmt(eff, '.4f')}" + (f" ({cert['note']})" if cert.get("note") else ""))
         if cert.get("candidates"):
             print(f"  (candidates: {cert['candidates']})")
@@ -429,6 +461,48 @@ def _print_text(out, res, robot):
                   f"{_fmt(d[k('crlb_at_truth_rms')] / p[k('crlb_at_truth_rms')], '.4f')}")
     if "plot" in out:
         print(f"plot: {out['plot']}")
+
+
+#: the detection summary's rows: (key of ``detection.power``, label)
+_POWER_ROWS = (("reversed", "poses visited in reverse"), ("swaps", "two poses swapped (least)"),
+               ("scale_error", "every length {scale} off"), ("bad_reading", "one bad reading of {bad} mm (least)"),
+               ("entries_at_tolerance", "a robot-file entry at its tolerance (least)"))
+
+
+def _print_detection(out, ju):
+    """What the fit check of the design and of the baseline sees (``detection``), and a checked design's cost."""
+    d, pd = out.get("detection"), (out.get("paper") or {}).get("detection")
+    if not d:
+        return
+    base = out.get("baseline", "paper") if pd else ""
+    print()
+    print(f"{'fit check (alpha ' + format(d['alpha'], 'g') + '): power against':48}{'design':>10}{base:>12}")
+    print(f"  {'spare degrees of freedom':46}{d['dof']:>10}{(pd or {}).get('dof', ''):>12}")
+    scale = next((f"{r['size']:g} %" for r in d["scenarios"] if r["name"] == "scale"), "")
+    bad = next((f"{r['size']:g}" for r in d["scenarios"] if r["kind"] == "reading"), "")
+    for key, label in _POWER_ROWS:
+        pv = (pd or {}).get("power", {}).get(key) if pd else None
+        print(f"  {label.format(scale=scale, bad=bad):46}{_fmt(d['power'].get(key), '.3f'):>10}"
+              f"{_fmt(pv, '.3f') if pd else '':>12}")
+    for name, x in (("design", d), (base, pd)):
+        if not x:
+            continue
+        verdict = "sees what it must" if x["meets"] else ("misses " + ", ".join(x["unmet"]) if x["unmet"]
+                                                           else x.get("note", "cannot run"))
+        print(f"  {name}: {verdict}")
+    inv = d.get("invisible_entries")
+    print(f"  (required: power >= {d['power_target']:g} against every order error, and against the scale error and "
+          f"a bad reading unless it moves no offset by {d['harm_sigma']:g} sigma ({d['harm_counted_in']}); "
+          + ("each entry at its tolerance likewise (--require-entries)" if d.get("entries_required") else
+             "a single entry at its tolerance is reported, not required (--require-entries)")
+          + (f"; no design sees {', '.join(inv)}" if inv else "") + ")")
+    c = out.get("checked")
+    if c:
+        cd = c["crlb_design"]
+        misses = ", ".join(cd.get("unmet") or []) or "nothing"
+        print(f"checked: CRLB {_fmt(out['criterion']['value'])} {ju} = {_fmt(c['cost'], '.4f')} x the crlb-optimal "
+              f"design's {_fmt(cd['crlb'])} {ju}, whose fit check misses {misses}"
+              + (f" ({c['note']})" if c.get("note") else ""))
 
 
 def _run_target(args, robot):
@@ -501,5 +575,6 @@ def _run_target(args, robot):
 
 def _desc(name):
     from zerocal_sym.design import CRITERIA
+    from zerocal_sym.design.criteria import CHECKED, CHECKED_DESCRIPTION
 
-    return CRITERIA[name][0]
+    return CHECKED_DESCRIPTION if name == CHECKED else CRITERIA[name][0]

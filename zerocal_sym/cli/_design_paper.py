@@ -81,6 +81,10 @@ def run(args, robot):
     }
     if robot.name == "paper":
         out["paper"] = {"n": 3, "kappa_1": PAPER_KAPPA_1, "kappa_m": PAPER_KAPPA_M}
+    from zerocal_sym.design.detection import detection
+    from zerocal_sym.io.files import json_safe
+
+    out["detection"] = json_safe(detection(robot, P, noise))  # what this scheme's fit check sees
     write_out(args, out)
     from zerocal_sym.cli._interrupt import outputs_written
 

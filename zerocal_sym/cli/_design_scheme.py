@@ -129,6 +129,9 @@ def run(args, robot):
             table.append({"n": k, "K": kk_, "kappa_1": kk, okey(robot, "crlb_rms"): float(np.sqrt(np.mean(c**2))),
                           okey(robot, "crlb_rms") + "_scale_only": float(np.sqrt(np.mean(cs**2)))})
         out["n_table"] = table
+    from zerocal_sym.design.detection import detection
+
+    out["detection"] = detection(robot, P, noise)  # what this scheme's fit check sees
     out = json_safe(out)
     write_out(args, out)
     from zerocal_sym.cli._interrupt import outputs_written

@@ -29,6 +29,12 @@ def offsets_sigma_text(res, goal=None) -> str:
         return "offsets' 1 sigma not available"
     s = ", ".join(f"{x:.3g}" for x in std)
     kind = f" ({res.std_kind})" if getattr(res, "std_kind", None) else ""
+    info = getattr(res, "info", None) or {}
+    bounds = [n for n, k in (info.get("std_kinds") or {}).items() if k == "bound" and n in res.zero_offset_names]
+    if bounds:  # TSVD: an offset whose linearisation bias is not known well enough has an upper bound for its std
+        truncated = info.get("truncation", len(res.params)) < len(res.params)
+        kind = (f" (an upper bound for {', '.join(bounds)}: " + ("the truncated directions' bias)" if truncated else
+                "TSVD's linearisation bias is not small or not known within the noise; --iterate removes it)"))
     worst = float(np.max(std))
     u = getattr(res, "offset_unit", "deg")
     if goal is not None:

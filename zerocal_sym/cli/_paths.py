@@ -34,6 +34,10 @@ class PathType:
         return self.kind
 
 
+#: the label of a robot file option (its ``mechanism_module`` is an input as well: :func:`check_paths`)
+ROBOT_FILE = "the robot file"
+
+
 class InputFile(PathType):
     """A file the command reads (``label``: how messages name it, e.g. ``the measurement file``).
 
@@ -117,4 +121,10 @@ def check_paths(args) -> None:
     for opt, _, value, is_dir in inputs:
         if str(value) == "":
             raise OutputError(f"{opt}: empty {'directory' if is_dir else 'file'} name")
-    check_outputs(outputs, [(f"{label} ({opt})", value) for opt, label, value, is_dir in inputs if not is_dir])
+    protected = [(f"{label} ({opt})", value) for opt, label, value, is_dir in inputs if not is_dir]
+    if outputs:  # a robot file's mechanism_module is read with it: an input too
+        from zerocal_sym.model.robot import module_file
+
+        protected += [(f"the mechanism module of {label} ({opt})", module) for opt, label, value, is_dir in inputs
+                      if label == ROBOT_FILE for module in [module_file(value)] if module is not None]
+    check_outputs(outputs, protected)

@@ -64,7 +64,9 @@ def add_arguments(p):
     p.add_argument("--no-geometric", action="store_true",
                    help="leave Table 2's geometric errors out of the plant (with --group/--all: the "
                         "4-parameter model is then exact)")
-    p.add_argument("--mu0", type=float, default=0.1, help="loop threshold of mu, deg (default 0.1)")
+    p.add_argument("--mu0", type=float, default=None,
+                   help="loop threshold of mu, in the joints' unit (default: verify's, 0.1 deg for revolute and "
+                        "0.02 mm for prismatic joints)")
     p.add_argument("--max-iter", type=int, default=20, help="identifications per loop (default 20)")
     p.add_argument("--seed", type=int, default=0, help="seed (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -86,6 +88,8 @@ def run(args):
     from zerocal_sym.errors import ZerocalError
     from zerocal_sym.identify.montecarlo import format_compare
     from zerocal_sym.io.files import to_json, write_json
+    from zerocal_sym.cli.cmd_verify import MU0_DEFAULT
+    from zerocal_sym.model import units
     from zerocal_sym.model.noise import NoiseModel
 
     robot = load_robot_arg(args)
@@ -125,7 +129,8 @@ def run(args):
     noise = NoiseModel.named(args.noise, robot)
     ex = _parallel.execution(args)  # checked (and a scheduler reached) before any work
     common = dict(trials=args.trials, poses=poses, params=params, noise=noise, seed=args.seed, methods=methods,
-                  mu0_deg=args.mu0, max_iter=args.max_iter, **ex)
+                  mu0_deg=MU0_DEFAULT[units.joint_unit(robot)] if args.mu0 is None else args.mu0,
+                  max_iter=args.max_iter, **ex)
     try:
         rep = _run(args, robot, use_table2, groups if use_table2 else None, None if use_table2 else truth, common)
     finally:

@@ -97,7 +97,7 @@ def run(args):
     from zerocal_sym.model import units
     from zerocal_sym.io.files import atomic_write_text, to_json
     from zerocal_sym.io.measurements import format_template
-    from zerocal_sym.io.poses import load_poses
+    from zerocal_sym.io.poses import load_design_poses
     from zerocal_sym.io.results import load_result
 
     robot = load_robot_arg(args)
@@ -141,16 +141,19 @@ def run(args):
         text, what, K = format_compensation(res, {"result": args.result}, mechanism=robot), "compensation table", 0
     else:
         if args.poses is not None:
-            P, source = load_poses(args.poses, robot, args.allow_revisits, measured=args.template), args.poses
+            (P, region), source = load_design_poses(args.poses, robot, args.allow_revisits, measured=args.template), \
+                args.poses
         else:
             P, n = scheme_poses(robot, args.scheme, args.n, identifiable=args.template)
-            source = f"--scheme {args.scheme} --n {n}"
+            source, region = f"--scheme {args.scheme} --n {n}", None
         nominal, cmd = compensated_commands(robot, P, offsets)
         K = len(P)
         if args.template:  # a round identify would refuse is refused now, not after the measurements
-            check_round_poses(robot, P, cmd, source, allow_revisits=True)  # (the pose file's revisits: read so)
+            check_round_poses(robot, P, cmd, source, allow_revisits=True,  # (the pose file's revisits: read so)
+                              region=region)
             meta[units.joint_key(robot, "compensation")] = format_offsets(offsets)
             meta.update(revisits_meta(P))  # the template says its revisits are intended
+            meta.update(region or {})  # a design's own region travels with its poses
             text, what = format_template(cmd, P, meta, mechanism=robot), "measurement template"
         else:
             text, what = format_commands(P, nominal, cmd, offsets, meta, mechanism=robot), "compensated commands"

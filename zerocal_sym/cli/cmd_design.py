@@ -56,8 +56,11 @@ def add_arguments(p):
     p.add_argument("--K", type=int, default=None,
                    help="number of poses (--optimize; default the K of the scheme's default n: 6 paper, 12 ring, "
                         "64 corners)")
-    p.add_argument("--criterion", choices=["cond", "D", "A", "E", "crlb", "position", "mse"], default="crlb",
-                   help="design criterion (--optimize)")
+    p.add_argument("--criterion", choices=["cond", "D", "A", "E", "crlb", "position", "mse", "checked"],
+                   default="checked",
+                   help="design criterion (--optimize): checked, the least CRLB among designs whose fit check "
+                        "sees reversed or swapped poses, a bad reading and a robot file off in scale; crlb, the least "
+                        "CRLB alone")
     p.add_argument("--region", nargs="+", metavar="SPEC", default=None,
                    help="design region (default: the workspace): XMIN XMAX YMIN YMAX on a rectangle, RW ZMIN ZMAX "
                         "on a cylinder (mm), X_MIN X_MAX ... YAW_MIN YAW_MAX on a box (mm, deg for orientations); "

@@ -251,7 +251,7 @@ def run(args):
         raise ZerocalError(f"--loss {args.loss}: a robust loss does not take the robot file's shared revisit error "
                            f"([noise] revisit_std_mm = {noise.sigma_revisit_mm:g}): use --loss l2, or --noise "
                            "scale-only / servo-only")
-    from zerocal_sym.identify.bias import make_tolerances, tolerance_bias
+    from zerocal_sym.identify.bias import make_tolerances
 
     auto = args.params == "auto"
     try:  # the tolerances of the errors left out, checked before any work
@@ -331,7 +331,7 @@ def run(args):
     err0 = evaluation_point(robot, meas, res, prior)
     report = identifiability_report(robot, meas.theta_cmd, names, noise, err0=err0)
     out = result_json(robot, meas, res, report, args.data, args.accept_misfit)
-    bias = tolerance_bias(robot, meas.theta_cmd, tol, params=names, noise=noise, err0=err0)
+    bias = _bias_report(robot, meas, res, tol, names, noise, err0, prior, args)
     out["bias"] = bias
     out.update(budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol))
     if not res.success:
@@ -401,6 +401,32 @@ def run(args):
         print(f"wrote {args.out}")
     print(verdict_line(res, args, out.get("remedy"), meas.K))
     return 0
+
+
+def _bias_report(robot, meas, res, tol, names, noise, err0, prior, args) -> dict:
+    """The bias the omitted errors' tolerances may put on this method's estimate: TSVD's own operator (at its last
+    step's linearisation point, its truncation) or the weighted fit's sensitivity, linearised at the estimate
+    (TSVD's less its linearisation bias), each offset's worst case searched on the exact model
+    (:mod:`zerocal_sym.identify.bias_exact`)."""
+    import numpy as np
+
+    from zerocal_sym.identify import bias_exact
+    from zerocal_sym.identify.bias import tsvd_bias_operator
+
+    errors = robot.errors
+    if res.method == "tsvd":
+        inc = np.asarray(res.info.get("increment", np.zeros(len(names))), float)
+        lin = errors.put(prior, names, res.estimate - inc) if np.all(np.isfinite(inc)) else prior
+        op = tsvd_bias_operator(robot, meas.theta_cmd, lin, t=res.info.get("truncation"))
+        est = bias_exact.tsvd_estimator(robot, meas.theta_cmd, prior, t=res.info.get("truncation"),
+                                        iterations=int(res.info.get("tsvd_iterations", 1)))
+        b = np.asarray(res.info.get("linearisation_bias", np.full(len(names), np.nan)), float)
+        if np.all(np.isfinite(b)):  # around the truth TSVD's estimate stands for: its estimate less its own bias
+            err0 = errors.put(err0, names, res.estimate - b)
+        return bias_exact.tolerance_bias_exact(robot, meas.theta_cmd, tol, names, noise, err0, est, operator=op,
+                                               estimator_name="tsvd (its unweighted, truncated operator)")
+    est = bias_exact.nlls_estimator(robot, meas.theta_cmd, names, noise, err0)
+    return bias_exact.tolerance_bias_exact(robot, meas.theta_cmd, tol, names, noise, err0, est)
 
 
 def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol) -> dict:

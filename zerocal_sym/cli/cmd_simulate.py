@@ -29,7 +29,8 @@ the paper's on a rectangular workspace, the ring scheme on a cylinder) with
 ring), or ``--poses FILE`` (a pose list, ``[pose,]x_mm,y_mm[,z_mm]``, or the
 JSON of ``zerocal design``).
 
-``--compensation`` (one value per joint, deg) and the commanded angles in
+``--compensation`` (one value per joint in the joints' unit: deg for
+revolute, mm for prismatic joints) and the commanded joints in
 the file are in the robot's frame (the frame of the robot file and of
 identification results).
 
@@ -63,9 +64,9 @@ def add_arguments(p):
     p.add_argument("--n", type=int, default=None,
                    help="the scheme's size: poses per boundary, K = 2n (default: 3 paper, 6 ring), or the corners, K = n "
                         "(16, 32 or 64; default 64)")
-    p.add_argument("--compensation", nargs="+", type=float, metavar="DEG", default=None,
-                   help="compensation already applied, one value per joint, deg (robot frame): "
-                        "commanded = IK - compensation")
+    p.add_argument("--compensation", nargs="+", type=float, metavar="X", default=None,
+                   help="compensation already applied, one value per joint in the joints' unit (deg for revolute, "
+                        "mm for prismatic joints; robot frame): commanded = IK - compensation")
     p.add_argument("--frame", choices=["paper", "literal"], default=None,
                    help="how Table 2 is read with --group (default: paper = mirrored about x)")
     p.add_argument("--out", required=True, metavar="FILE.csv", type=OutputFile(), help="output measurement file")
@@ -96,7 +97,7 @@ def run(args):
     import numpy as np
 
     from zerocal_sym.cli import load_robot_arg
-    from zerocal_sym.cli._common import fmt_values, format_named, poses_arg, revisits_meta, scheme_poses, vector_arg
+    from zerocal_sym.cli._common import fmt_values, format_named, revisits_meta, scheme_poses, vector_arg
     from zerocal_sym.errors import PoseError
     from zerocal_sym.identify.loop import simulate_round
     from zerocal_sym.io.compensation import format_offsets
@@ -116,15 +117,27 @@ def run(args):
             from zerocal_sym.errors import ZerocalError
 
             raise ZerocalError("--n is the number of poses per boundary of a scheme: not with --poses")
-        poses, pose_what = poses_arg(robot, args.poses, None, allow_revisits=args.allow_revisits)
+        from zerocal_sym.io.poses import load_design_poses
+
+        poses, region = load_design_poses(args.poses, robot, args.allow_revisits, measured=True)
+        pose_what = str(args.poses)
     else:
         poses, n = scheme_poses(robot, args.scheme, args.n)
+        region = None
         pose_what = f"{robot.workspace.scheme_name} scheme, n = {n}"
     rng = np.random.default_rng([args.seed, args.group] if args.group is not None else [args.seed])
     meas = simulate_round(robot, VirtualPlant(robot, err), poses, units.joints_from_user(robot, comp_user),
                           NoiseModel.named(args.noise, robot), rng)
-    if not np.all(np.isfinite(meas.readings)):
-        raise PoseError("the compensated commands leave the robot's assembly (reading is not finite)")
+    bad = np.flatnonzero(~np.isfinite(meas.readings))
+    if bad.size:  # the true robot does not assemble at these commands (or its forward kinematics do not converge)
+        from zerocal_sym.model.kinematics import fmt_pose, fmt_user_pose
+
+        k = int(bad[0])
+        raise PoseError(f"pose {k} {fmt_user_pose(robot, poses[k])}: with these true errors the commanded "
+                        f"{units.joint_noun(robot)} {fmt_pose(units.joints_to_user(robot, meas.theta_cmd[k]))} {ju} "
+                        "are not an assembly of the robot (its forward kinematics find no pose: a limb cannot "
+                        f"close, or the solve does not converge); {bad.size} of {meas.K} poses: errors this large "
+                        "are not a calibration's")
     offsets_user = units.joints_to_user(robot, errors.take(err, errors.zero_offsets))
     maemm = errors.take(err, errors.measuring)
     meas.meta = {
@@ -141,6 +154,7 @@ def run(args):
         "true_maemm_mm": fmt_values(maemm),
         "true_errors": format_named(robot, err).replace(" deg", "").replace(" mm", ""),
         **revisits_meta(poses),  # the poses revisit on purpose (they were read so): the file says it
+        **(region or {}),  # poses of a design's own region, outside the workspace: the region travels with them
     }
     if args.group is not None:
         meas.meta["n"] = len(poses) // 2

@@ -455,7 +455,12 @@ def load_spec(path, allow_revisits: bool = False) -> Study:
         raise StudySpecError("no cell: every [[design]] or [[truth]] is filtered out for every robot",
                              where=str(path))
     check_spec(study, where, StudySpecError)  # what this machine can hold: chunk files, memory
-    study.inputs = ([("a robot file of the spec", base / r) for r in raw["robots"] if r != "paper"]
+    from zerocal_sym.model.robot import module_file
+
+    robot_files = [base / r for r in raw["robots"] if r != "paper"]
+    study.inputs = ([("a robot file of the spec", f) for f in robot_files]
+                    + [("the mechanism module of a robot file of the spec", m) for m in map(module_file, robot_files)
+                       if m is not None]
                     + [("a pose file of the spec", base / dt["poses"]) for dt in designs if "poses" in dt])
     return study
 

@@ -39,6 +39,7 @@ from zerocal_sym.design.constraints import Constraints, _pointwise_ok, make_cons
 from zerocal_sym.design.criteria import _check_criterion, _criterion_weights, _user_value
 from zerocal_sym.design.fewest import fewest_poses  # noqa: F401 - kept importable from here (benchmarks)
 from zerocal_sym.design.limits import DesignError
+from zerocal_sym.design.certify import boundary_points, search_region
 from zerocal_sym.design.measure import TOL, e_certificate, solve_measure
 from zerocal_sym.design.posemodel import E_Q, PoseModel, _crit, _schur, _sens, _stats
 from zerocal_sym.design.terms import Weights
@@ -165,6 +166,35 @@ class ApproxDesign:
     info: dict = field(default_factory=dict)
     #: the zero offsets' internal unit (rad, mm): the crlb criterion's value is in its file unit (deg, mm)
     unit: str = "rad"
+    #: ``(window, candidates (N_w, n), measure)`` of each window the bound is the least over (:meth:`covered`)
+    bound_windows: list = field(default_factory=list, repr=False, compare=False)
+    noise: object = field(default=None, repr=False, compare=False)
+    weights: object = field(default=None, repr=False, compare=False)
+
+    def covered(self, robot, P) -> "ApproxDesign":
+        """The same measure with the bound over the candidates *and* the poses ``P`` (K, n): a design's own
+        poses, so its efficiency is certified on a set it lies in.
+
+        Each window's bound (the equivalence theorem's, :func:`_loss_bound`) takes the largest sensitivity
+        over its candidates and the poses of ``P`` with ``rho`` in it (one window: all of them); E: its
+        certificate over both (:func:`~zerocal_sym.design.measure.e_certificate`).
+        """
+        from dataclasses import replace
+
+        from zerocal_sym.design.certify import with_poses
+
+        P = np.atleast_2d(np.asarray(P, float))
+        if not self.bound_windows or not len(P):
+            return self
+        sols = with_poses(robot, self.criterion, self.noise, self.weights, self.bound_windows, P)
+        out = min(_loss_bound(self.criterion, sol) for sol in sols)
+        info = dict(self.info, design_poses=len(P))
+        info["candidates"] = str(info.get("candidates", "")).replace(
+            ": the bound covers", f", and the design's {len(P)} poses: the bound covers")
+        eff = _efficiency(self.criterion, _mass_value(self.criterion, self.loss, 1, self.p),
+                          _mass_value(self.criterion, out, 1, self.p), self.p)
+        return replace(self, bound_loss=out, n_candidates=self.n_candidates + len(P), info=info,
+                       eff_lb=float(eff) if eff is not None else self.eff_lb)
 
     def sensitivity(self, robot, noise=None):
         """``d(x) / s`` of the measure at new poses: a function of ``X`` (M, n) -> (M,) (1 on the support)."""
@@ -280,7 +310,7 @@ def _clusters(X, w, radius, min_frac=1e-4):
 
 def approximate_design(robot, criterion="crlb", cons: Constraints | None = None, noise=None,
                        n_candidates: int = N_CANDIDATES, tol: float = TOL, refine: int = 2,
-                       tolerances=None) -> ApproxDesign:
+                       tolerances=None, search: bool = True) -> ApproxDesign:
     """The optimal design measure over feasible candidate poses, with its certificate.
 
     Parameters
@@ -294,6 +324,9 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         Target efficiency gap of the measure.
     refine : int
         Rounds of local refinement of the support (grid spacing / 3 each).
+    search : bool
+        Add the local maxima of the sensitivity over the region to the candidates, for the measure and
+        for each window's bound (:func:`zerocal_sym.design.certify.search_region`).
 
     Returns
     -------
@@ -310,13 +343,18 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
     cons = cons or make_constraints(robot)
     wts = _criterion_weights(robot, criterion, tolerances) if criterion == "position" else Weights(robot, tolerances)
     X, h = candidate_poses(robot, cons, n_candidates)
+    n_boundary = 0
+    if search:  # the grid's cells closed at the feasible set's boundary
+        B = boundary_points(robot, cons, X, h)
+        X, n_boundary = np.vstack([X, B]), len(B)
     if np.ndim(h):
         k = int(round(float((cons.region.hi[0] - cons.region.lo[0]) / h[0]))) + 1
-        grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X)} feasible poses)"
+        grid = f"a {k}-per-coordinate grid over the {robot.n}-D region ({len(X) - n_boundary} feasible poses)"
     else:
-        grid = f"a grid over the region, {h:.3g} mm apart ({len(X)} feasible poses)"
-    candidates = (f"{grid} and {refine} round{'s' if refine != 1 else ''} of local refinement around the "
-                  "measure's support: the bound covers designs on these candidates, not every pose of the region")
+        grid = f"a grid over the region, {h:.3g} mm apart ({len(X) - n_boundary} feasible poses)"
+    closed = f", {n_boundary} points on the boundary of the feasible set next to it" if n_boundary else ""
+    candidates = (f"{grid}{closed} and {refine} round{'s' if refine != 1 else ''} of local refinement around the "
+                  "measure's support")
     model = PoseModel(robot, X, noise, criterion, wts)
     p = model.aq.shape[1]
     exact, enlarged = _windows(model.rho, cons)
@@ -370,20 +408,43 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
         w0 = 0.9 * w0 / w0.sum() + 0.1 / len(w0)
         sol = solve_measure(model.subset(idx), criterion, w0, tol, certify=r == refine - 1)
         iters += sol["iterations"]
+    n_grid = len(model.X)
+    region = {"starts": 0, "added": 0, "rounds": 0, "max_ratio": None}
+
+    def resolve(mod, ix, w0):
+        return solve_measure(mod.subset(ix), criterion, w0, tol)
+
+    def searched(mod, ix, sl, wn):
+        """The measure of a window with the local maxima of its sensitivity over the region added."""
+        if not search:
+            return mod, ix, sl
+        mod, ix, sl, inf = search_region(robot, cons, noise, criterion, wts, mod, ix, sl, wn, h, resolve, mod.W)
+        for k_ in ("starts", "added", "rounds"):
+            region[k_] += inf[k_]
+        region["max_ratio"] = max(region["max_ratio"] or 0.0, inf["max_ratio"])
+        return mod, ix, sl
+
+    model, idx, sol = searched(model, idx, sol, win)
     if criterion == "E" and sol.get("E_bound") is None:
         sol["eff_lb"], sol["E_bound"] = e_certificate(model.subset(idx), sol["M"], sol["c"])
     # the bound over every window (enlarged windows cover all l0-windows)
+    bounds = []  # (window, indices, measure) of each window the bound is the least over
     if len(enlarged) == 1:
-        bound_loss = _loss_bound(criterion, sol)
+        bounds.append((win, idx, sol))
     else:
-        bound_loss = math.inf
         for ew in enlarged:
-            _, bsol = solve_in(model, ew)
+            bidx, bsol = solve_in(model, ew)
             if bsol is None:
                 continue
             iters += bsol["iterations"]
-            bound_loss = min(bound_loss, _loss_bound(criterion, bsol))
-        bound_loss = min(bound_loss, _loss_bound(criterion, sol))
+            model, bidx, bsol = searched(model, bidx, bsol, ew)
+            bounds.append((ew, bidx, bsol))
+        bounds.append((win, idx, sol))
+    bound_loss = min(_loss_bound(criterion, b[2]) for b in bounds)
+    if search:
+        candidates += (f", and {region['added']} local maxima of the sensitivity over the region (a pattern search "
+                       f"from {region['starts']} starts, the cells a Lipschitz-type screen flags)")
+    candidates += ": the bound covers designs on these candidates, not a proof over every pose of the region"
     sub = model.subset(idx)
     reps, ws = _clusters(sub.X, sol["w"], 1.5 * h / 3 ** refine)
     loss = user_loss(sol)
@@ -392,5 +453,7 @@ def approximate_design(robot, criterion="crlb", cons: Constraints | None = None,
                         loss=loss, bound_loss=bound_loss, window=win, n_candidates=len(model.X), iterations=iters,
                         windows=len(exact), p=p, time_s=time.perf_counter() - t0,
                         info={"grid_mm": h if np.ndim(h) == 0 else np.asarray(h).tolist(), "refine_rounds": refine,
-                              "q": sol["q"], "candidates": candidates},
-                        unit=robot.errors.offset_unit)
+                              "q": sol["q"], "candidates": candidates, "region_search": region if search else None,
+                              "n_grid_and_refinements": n_grid},
+                        unit=robot.errors.offset_unit,
+                        bound_windows=[(b[0], model.X[b[1]], b[2]) for b in bounds], noise=noise, weights=wts)

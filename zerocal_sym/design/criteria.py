@@ -85,6 +85,13 @@ CRITERIA = {
 }
 #: criteria that need the omitted errors' sensitivities (``Weights.extend``)
 EXTENDED = ("mse",)
+#: the checked design's criterion: the crlb's value among the designs whose fit check sees what they assume
+#: (:mod:`zerocal_sym.design.detection`); not a Fisher criterion of its own (not in :data:`CRITERIA`)
+CHECKED = "checked"
+CHECKED_DESCRIPTION = ("RMS Cramer-Rao bound of the zero offsets among designs whose fit check sees reversed or "
+                       "swapped poses, a bad reading and the robot file's errors")
+#: every criterion a design can be optimised for
+DESIGN_CRITERIA = tuple(CRITERIA) + (CHECKED,)
 
 
 def criteria_table(robot) -> dict:
@@ -308,14 +315,18 @@ def _user_value(criterion, obj, unit: str = "rad"):
 
 # --------------------------------------------------------------------------- evaluation
 def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
-             cons: Constraints | None = None, tolerances=None) -> dict:
+             cons: Constraints | None = None, tolerances=None, requirement=None) -> dict:
     """Report of one ordered design.
 
     Parameters
     ----------
+    criterion : str
+        One of :data:`DESIGN_CRITERIA` (``checked``: the value is the crlb's).
     tolerances : dict name -> value (internal units), optional
         Tolerances of the omitted errors (``mse`` and the ``bias`` entry;
         default :func:`zerocal_sym.identify.bias.default_tolerances`).
+    requirement : zerocal_sym.design.detection.Requirement, optional
+        What the ``detection`` entry judges (default: its defaults with ``tolerances``).
 
     Returns
     -------
@@ -332,7 +343,8 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
         and the RMS error ``sqrt(CRLB^2 + RMS bias^2)`` per offset),
         ``position`` (RMS and worst position error over the workspace grid
         after compensation, mm), ``kappa`` (the paper's kappa_1 of G, no
-        MAEMM prior), ``rho_span_mm``, ``min_transmission_sine`` and, with
+        MAEMM prior), ``rho_span_mm``, ``min_transmission_sine``,
+        ``detection`` (what the fit check sees: :func:`zerocal_sym.design.detection.detection`) and, with
         ``cons``, ``violations``.
     """
     from zerocal_sym.identify import bias, fisher
@@ -350,6 +362,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
     bias_rep = _bias_report(robot, t["theta"], noise, tolerances, crlb)
     pos = position_report(robot, P, noise)
     G, _ = identification_matrix(robot, P, theta=t["theta"])
+    name = "crlb" if criterion == CHECKED else criterion
     rep = {
         "poses": poses_to_user(robot, P).tolist(),
         "pose_units": pose_units(robot),
@@ -357,7 +370,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
         "pose_names": list(robot.mechanism.pose_names),
         "joint_names": list(robot.mechanism.joint_names),
         "joint_unit": offset_unit(robot),
-        "criterion": {"name": criterion, "value": vals[criterion], "units": table[criterion][1],
+        "criterion": {"name": criterion, "value": vals[name], "units": table[name][1],
                       "values": vals, "units_all": {c: table[c][1] for c in table}},
         okey(robot, "crlb_zero_offsets"): crlb,
         okey(robot, "crlb_rms"): float(np.sqrt(np.mean(np.square(crlb)))),
@@ -366,10 +379,21 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
         "kappa": condition_number(G),
         "rho_span_mm": float(np.ptp(t["rho"])),
         "min_transmission_sine": float(np.min(np.abs(t["s"]))),
+        "detection": _detection(robot, P, noise, tolerances, requirement),
     }
     if cons is not None:
         rep["violations"] = check_design(robot, P, cons)
     return rep
+
+
+def _detection(robot, P, noise, tolerances, requirement):
+    """:func:`zerocal_sym.design.detection.detection` of a design, None where it cannot identify the parameters."""
+    from zerocal_sym.design.detection import Requirement, detection
+
+    try:
+        return detection(robot, P, noise, requirement or Requirement(robot, tolerances))
+    except (np.linalg.LinAlgError, PoseError):
+        return None
 
 
 def _bias_report(robot, theta, noise, tolerances, crlb):
@@ -429,9 +453,9 @@ def position_report(robot, P, noise=None) -> dict:
             "grid_points": len(grid)}
 
 
-def _check_criterion(criterion):
-    if criterion not in CRITERIA:
-        raise DesignError(f"unknown criterion {criterion!r} (known: {', '.join(CRITERIA)})")
+def _check_criterion(criterion, known=CRITERIA):
+    if criterion not in known:
+        raise DesignError(f"unknown criterion {criterion!r} (known: {', '.join(known)})")
 
 
 def _terms_batch(robot, P, noise, omitted=False):

@@ -30,7 +30,8 @@ def candidate_grid(robot, cons: Constraints, *grid):
 
 
 def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
-                    n_starts: int = 8, grid=None, max_sweeps: int = 50, tolerances=None, step=None):
+                    n_starts: int = 8, grid=None, max_sweeps: int = 50, tolerances=None, step=None,
+                    objective=None):
     """Discrete coordinate exchange over a candidate grid.
 
     Each start is a random ordered set of K distinct feasible candidates
@@ -48,6 +49,10 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         Tolerances of the omitted errors (``mse``).
     step : callable, optional
         ``step()`` after each start (progress).
+    objective : callable, optional
+        ``objective(candidates)`` returns a function of index sets (B, K) into the candidates (N, n) giving
+        B internal objectives (smaller is better): used instead of the criterion's (the checked design,
+        :mod:`zerocal_sym.design.checked`); ``value`` is then the criterion's value of the best design.
 
     Returns
     -------
@@ -73,6 +78,11 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
     rho = t["rho"]
     rng = np.random.default_rng(seed)
     N = len(cand)
+    if objective is None:
+        def fn(idx):
+            return _objective_batch(criterion, aq_all[idx], v_all[idx], sm2, wc)
+    else:
+        fn = objective(cand)
     close = None
     if cons.min_separation_mm > 0:
         close = pose_distances(robot, cand) < cons.min_separation_mm
@@ -83,14 +93,14 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         if idx is None:
             raise DesignError(f"no {K} candidate poses fit the scale travel l0 = {cons.travel_mm:g} mm "
                               f"({cons.travel_mode}) and the minimum separation {cons.min_separation_mm:g} mm")
-        cur = _objective_batch(criterion, aq_all[idx][None], v_all[idx][None], sm2, wc)[0]
+        cur = fn(idx[None])[0]
         for _sweep in range(max_sweeps):
             improved = False
             for pos in rng.permutation(K):
                 free = np.setdiff1d(np.arange(N), idx)
                 trial = np.repeat(idx[None], len(free), axis=0)
                 trial[:, pos] = free
-                o = _objective_batch(criterion, aq_all[trial], v_all[trial], sm2, wc)
+                o = fn(trial)
                 if cons.travel_mode == "range":
                     o[np.ptp(rho[trial], axis=1) > cons.travel_mm] = np.inf
                 else:
@@ -110,6 +120,8 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
             best_idx, best_o = idx.copy(), cur
     if not np.isfinite(best_o):
         raise DesignError("every exchange start is rank-deficient: the region cannot identify the parameters")
+    if objective is not None:
+        best_o = float(_objective_batch(criterion, aq_all[best_idx][None], v_all[best_idx][None], sm2, wc)[0])
     return {"poses": cand[best_idx], "objective": float(best_o),
             "value": _user_value(criterion, best_o, robot.errors.offset_unit),
             "starts": starts, "n_candidates": int(N), "grid": list(grid), "time_s": time.perf_counter() - t0}

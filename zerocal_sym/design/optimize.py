@@ -42,7 +42,7 @@ from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.design.limits import MAX_K_EXACT, DesignError, _check_k
 from zerocal_sym.design.shapes import BoxRegion, CylinderRegion, Region, workspace_region
 from zerocal_sym.design.constraints import Constraints, check_design, make_constraints
-from zerocal_sym.design.criteria import _check_criterion, _noise_terms, _objective, evaluate
+from zerocal_sym.design.criteria import CHECKED, DESIGN_CRITERIA, _check_criterion, _noise_terms, _objective, evaluate
 from zerocal_sym.design.exchange import exchange_design
 from zerocal_sym.design.nlp import continuous_design
 from zerocal_sym.design.order import best_order
@@ -210,6 +210,10 @@ class DesignResult:
     #: the baseline's poses in internal units (mm, rad), shape (K, n), or None (``paper["poses"]`` is in file
     #: units)
     baseline_poses: np.ndarray | None = None
+    #: the checked design's trade-off (:func:`zerocal_sym.design.checked.checked_design`), or None
+    checked: dict | None = None
+    #: the approximate design behind ``certificate`` (not in the report), or None
+    approx_design: object = field(default=None, repr=False)
 
     def to_dict(self) -> dict:
         """JSON-ready report (non-finite numbers as None)."""
@@ -254,6 +258,8 @@ class DesignResult:
         from zerocal_sym.design.replicates import revisits_entry
 
         rep.update(revisits_entry(self.poses))  # a pose file of the design accepts its replicates
+        if self.checked is not None:
+            rep["checked"] = self.checked
         return rep
 
 
@@ -278,11 +284,18 @@ def _ratio(a, b):
     return float(r) if math.isfinite(r) else None
 
 
-def _certificate(ad, criterion, value, K, design_value_crlb=None):
-    """The certificate block of a design from an approximate design of the same criterion (or crlb for mse)."""
+def _certificate(ad, criterion, value, K, design_value_crlb=None, robot=None, P=None):
+    """The certificate block of a design from an approximate design of the same criterion (or crlb for mse).
+
+    With the design's poses ``P`` the bound covers them too (:meth:`ApproxDesign.covered`): the efficiency
+    is never one against a candidate set the design lies outside; ``certificate`` says over how many poses.
+    """
     if ad is None:
         return None
-    d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K),
+    if robot is not None and P is not None:
+        ad = ad.covered(robot, P)
+    d = {"criterion": ad.criterion, "K": K, "bound": ad.bound(K), "certificate": f"over {ad.n_candidates} candidates",
+         "region_search": ad.info.get("region_search"),
          "measure_efficiency_lower_bound": ad.eff_lb, "n_candidates": ad.n_candidates,
          "rho_window_mm": list(ad.window), "windows": ad.windows, "candidates": ad.info.get("candidates"),
          "model": "order-free pose model (servo variance + sigma_m^2/4 per pose): its optimum bounds every "
@@ -301,7 +314,8 @@ def _certificate(ad, criterion, value, K, design_value_crlb=None):
 def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraints | None = None,
                     noise: NoiseModel | None = None, seed: int = 0, n_starts: int = 8,
                     exchange_starts: int = 8, grid=None, reorder: bool = True, tolerances=None,
-                    method: str = "auto", certificate: bool = True, progress=None) -> DesignResult:
+                    method: str = "auto", certificate: bool = True, progress=None,
+                    requirement=None) -> DesignResult:
     """Optimal measurement poses for a criterion, with the boundary scheme as baseline.
 
     Two paths (``method``):
@@ -336,7 +350,9 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     robot : Robot
     K : int
         Number of poses (>= p + 1: 5 for the planar robot, 7 for the Delta).
-    criterion : {"cond", "D", "A", "E", "crlb", "position", "mse"}
+    criterion : {"cond", "D", "A", "E", "crlb", "position", "mse", "checked"}
+        ``checked``: the crlb among designs whose fit check sees what they assume
+        (:func:`zerocal_sym.design.checked.checked_design`).
     cons : Constraints, optional
         Default :func:`make_constraints` (workspace, l0 = 350 mm range,
         the robot's margin, no joint limits).
@@ -355,6 +371,8 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     progress : callable, optional
         ``progress(done, total)`` after each step (the approximate design, each exchange and Ipopt start, each
         polish); ``done == total`` at the end.
+    requirement : zerocal_sym.design.detection.Requirement, optional
+        What a ``checked`` design must see (default: its defaults with ``tolerances``).
 
     Returns
     -------
@@ -365,7 +383,13 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
     from zerocal_sym.design.rounding import realize
 
     _check_k(K, robot)
-    _check_criterion(criterion)
+    _check_criterion(criterion, DESIGN_CRITERIA)
+    if criterion == CHECKED:
+        from zerocal_sym.design.checked import checked_design
+
+        return checked_design(robot, K, cons or make_constraints(robot), NoiseModel.coerce(noise, robot=robot),
+                              seed, n_starts, exchange_starts, grid, tolerances, method, certificate, requirement,
+                              progress)
     if method not in METHODS:
         raise DesignError(f"unknown design method {method!r} (known: {', '.join(METHODS)})")
     if method == "auto":
@@ -449,15 +473,16 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         label, P, _ = min(polished, key=lambda c: c[2])
     if progress is not None and done[0] < total:  # a random start that found no feasible design: done anyway
         progress(total, total)
-    report = evaluate(robot, P, criterion, noise, cons, tolerances)
+    report = evaluate(robot, P, criterion, noise, cons, tolerances, requirement)
     timing["total"] = time.perf_counter() - t0
     cert = None
     if ad is not None:
-        cert = _certificate(ad, criterion, report["criterion"]["value"], K, report["criterion"]["values"]["crlb"])
-    paper = None if base is None else evaluate(robot, base, criterion, noise, cons, tolerances)
+        cert = _certificate(ad, criterion, report["criterion"]["value"], K, report["criterion"]["values"]["crlb"],
+                            robot, P)
+    paper = None if base is None else evaluate(robot, base, criterion, noise, cons, tolerances, requirement)
     return DesignResult(poses=P, criterion=criterion, report=report, paper=paper, constraints=cons, exchange=ex,
                         continuous=cont, method=label, timing=timing, noise=noise, baseline=scheme,
                         baseline_note=base_note, baseline_rejected=rejected, baseline_label=base_label,
                         certificate=cert, approximate=approx_info, tolerances=tolerances,
                         noise_report=dict(noise_dict(robot, noise), description=describe_noise(robot, noise)),
-                        baseline_poses=base)
+                        baseline_poses=base, approx_design=ad)

@@ -19,13 +19,15 @@ from zerocal_sym.design.terms import _qscale, pose_terms
 
 # --------------------------------------------------------------------------- ordering
 def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None, exhaustive_max: int = 8,
-               tolerances=None):
+               tolerances=None, objective=None):
     """Visiting order of the poses that minimises the criterion.
 
     Exhaustive over all K! orders for ``K <= exhaustive_max``; otherwise a
     local search over pair swaps and segment reversals (2-opt) from the
     given order, best improvement first.  With the ``consecutive`` travel
-    mode, orders that break it are skipped.
+    mode, orders that break it are skipped.  ``objective(P)``, if given,
+    returns a function of permutations (B, K) giving B internal objectives,
+    used instead of the criterion's (the checked design).
 
     Returns
     -------
@@ -42,8 +44,10 @@ def best_order(robot, P, criterion, noise=None, cons: Constraints | None = None,
     rho = t["rho"]
     aq0, v0 = _criterion_terms(robot, criterion, t, qs, sx2, wc)
 
+    fn = None if objective is None else objective(P)
+
     def objective(perms):
-        o = _objective_batch(criterion, aq0[perms], v0[perms], sm2, wc)
+        o = _objective_batch(criterion, aq0[perms], v0[perms], sm2, wc) if fn is None else fn(perms)
         if cons is not None and cons.travel_mode == "consecutive":
             o[np.max(np.abs(np.diff(rho[perms], axis=1)), axis=1) > cons.travel_mm] = np.inf
         return o

@@ -83,7 +83,7 @@ def _gauss_newton_blocks(prob, z, P):
     J = np.full((n, K - 1, p), np.nan)
     todo = np.arange(n)
     for _ in range(GN_BLOCKS):  # only the data sets not yet converged go on
-        zk, sk, rk, _, Jk, *_ = prob.batch(todo.size)(z[:, todo], P[:, todo])
+        zk, sk, rk, _, Jk, *_ = prob.run_batch(z[:, todo], P[:, todo])
         z[:, todo] = zk.reshape(p, todo.size, order="F")
         step[todo] = np.ravel(sk)
         r[todo] = rk.reshape(K - 1, todo.size, order="F").T
@@ -239,11 +239,11 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
             std[k] = [res.std(nm) for nm in names]
             chi2[k] = res.info["chi2"]
             success[k] = True
-    from zerocal_sym.identify.chi2 import chi2_sf
+    from zerocal_sym.identify.chi2 import chi2_sf_array
 
     dof = K - 1 - p
     pv = np.full(N, np.nan)
     if dof > 0 and not noise.is_zero:
-        pv = np.array([chi2_sf(c, dof) if np.isfinite(c) else np.nan for c in chi2])
+        pv = np.where(np.isfinite(chi2), chi2_sf_array(np.where(np.isfinite(chi2), chi2, 0.0), dof), np.nan)
     return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed, chi2=chi2,
                        dof=dof, p_value=pv)

@@ -189,8 +189,50 @@ def tolerance_vector(robot, tolerances, names) -> np.ndarray:
     return np.array([float(tolerances.get(n, 0.0)) for n in names])
 
 
-def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None = None, err0=None):
+def tsvd_bias_operator(robot, theta_cmd, prior=None, t=None, rtol=None) -> np.ndarray:
+    """TSVD's own operator ``A`` (p, K-1): measured changes (mm) to its estimate (internal units), at its
+    linearisation point.
+
+    TSVD is unweighted and truncated: its estimate moves by ``A A_o e_o`` when the omitted errors are ``e_o``
+    (``A_o`` the changes' sensitivity to them), not by the weighted least-squares ``S`` -- pass ``A`` as
+    ``operator`` to :func:`bias_sensitivity` and :func:`tolerance_bias`.
+
+    Parameters
+    ----------
+    theta_cmd : ndarray, shape (K, m)
+    prior : ndarray, shape (q,), optional
+        TSVD's linearisation point: the prior of its (last) step (default zero; an iterated TSVD's last step is
+        linearised at its estimate minus its last increment).
+    t : int, optional
+        Truncation level (default: the ``threshold`` rule, :data:`~zerocal_sym.identify.truncated_svd.DEFAULT_RTOL`
+        or ``rtol``); give the identification's own ``info["truncation"]`` for another rule.
+
+    Returns
+    -------
+    ndarray, shape (p, K - 1)
+        Rows the mechanism's default set (zero offsets, measuring errors).
+    """
+    from zerocal_sym.identify.linear import identification_matrix
+    from zerocal_sym.identify.truncated_svd import DEFAULT_RTOL
+
+    errors = robot.errors
+    names = errors.resolve("default")
+    prior = errors.zeros() if prior is None else errors.check_vector(prior)
+    P = kin.fk(robot, np.atleast_2d(theta_cmd) + errors.take(prior, errors.zero_offsets))
+    G, _ = identification_matrix(robot, P, maemm_prior=errors.take(prior, errors.measuring))
+    U, sv, Vt = np.linalg.svd(G, full_matrices=False)
+    if t is None:
+        t = int(np.count_nonzero(sv > (DEFAULT_RTOL if rtol is None else rtol) * sv[0]))
+    T = 1.0 / robot.error_scale(names)
+    return (T[:, None] * Vt[:t].T / sv[:t]) @ U[:, :t].T
+
+
+def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None = None, err0=None,
+                     operator=None):
     """``S = d(estimate) / d(omitted errors)`` of the weighted least-squares fit, first order.
+
+    ``operator`` (p, K-1): an estimator linear in the changes instead (TSVD: :func:`tsvd_bias_operator`):
+    ``S = operator A_o``, ``noise`` then unused.
 
     Parameters
     ----------
@@ -220,6 +262,12 @@ def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None 
     err0 = errors.zeros() if err0 is None else errors.check_vector(err0)
     _, de, _ = kin.distance_jacobians(robot, np.atleast_2d(theta_cmd), err0)
     A, Ao = np.diff(de[:, idx], axis=0), np.diff(de[:, om], axis=0)
+    if operator is not None:
+        operator = np.asarray(operator, float)
+        if operator.shape != (len(idx), A.shape[0]):
+            raise ValueError(f"operator must be ({len(idx)}, {A.shape[0]}): the {len(idx)} parameters from the "
+                             f"{A.shape[0]} changes, got {operator.shape}")
+        return operator @ Ao, names
     if not noise.is_zero:  # whitened by the banded Cholesky factor of Cov(s), O(K p)
         C = fisher.change_covariance(robot, theta_cmd, noise, err0)
         A, Ao = C.whiten(A), C.whiten(Ao)
@@ -228,8 +276,11 @@ def bias_sensitivity(robot, theta_cmd, params="paper", noise: NoiseModel | None 
 
 
 def tolerance_bias(robot, theta_cmd, tolerances=None, params="paper", noise: NoiseModel | None = None,
-                   err0=None) -> dict:
+                   err0=None, operator=None, estimator="weighted least squares") -> dict:
     """Worst-case and RMS bias of each identified parameter from the omitted errors' tolerances.
+
+    ``operator``: the estimator's own linear operator (TSVD, :func:`tsvd_bias_operator`), named ``estimator``
+    in the result; default the weighted least-squares fit's sensitivity.
 
     Parameters
     ----------
@@ -245,12 +296,12 @@ def tolerance_bias(robot, theta_cmd, tolerances=None, params="paper", noise: Noi
         ``rms`` (user units, per parameter), ``zero_offsets`` {``names``,
         ``unit``, ``worst_case_deg``, ``rms_deg``} (``_mm`` for prismatic joints), ``tolerances`` (user units by
         name), ``sensitivity`` (per omitted error, user units per user unit:
-        rows the parameters), ``model``.
+        rows the parameters), ``model``, ``estimator``.
     """
     errors = robot.errors
     names = errors.resolve(params)
     tol = default_tolerances(robot, params) if tolerances is None else dict(tolerances)
-    S, om = bias_sensitivity(robot, theta_cmd, params, noise, err0)
+    S, om = bias_sensitivity(robot, theta_cmd, params, noise, err0, operator=operator)
     t = tolerance_vector(robot, tol, om)
     worst = np.abs(S) @ t
     rms = np.sqrt((S ** 2) @ (t ** 2) / 3.0)
@@ -270,4 +321,5 @@ def tolerance_bias(robot, theta_cmd, tolerances=None, params="paper", noise: Noi
         "sensitivity": {"rows": list(names), "columns": list(om),
                         "values": (S * to_user[:, None] * from_user[None, :]).tolist()},
         "model": f"first order; worst case sum_j |S_ij| t_j; RMS sqrt(sum_j S_ij^2 t_j^2 / 3): {RMS_MODEL}",
+        "estimator": estimator,
     }

@@ -61,7 +61,8 @@ def error_budget(bias: dict, result) -> dict:
     dict
         ``error_budget``: one dict per zero offset in joint order with
         ``name``, ``unit``, ``noise_std`` (None when unknown),
-        ``robot_file_bias``, ``dominant_entries`` (up to
+        ``robot_file_bias`` (the larger of the first-order bound and, when
+        ``bias`` holds it, the exact model's worst corner), ``dominant_entries`` (up to
         :data:`N_DOMINANT` dicts ``name``, ``tolerance``, ``unit``,
         ``sensitivity`` (offset unit per entry unit, signed),
         ``contribution`` (offset unit)); ``limited_by`` (:data:`LIMITS`).
@@ -74,6 +75,10 @@ def error_budget(bias: dict, result) -> dict:
     units_ = bias.get("tolerance_units", {})
     unit = errors.offset_user_unit
     std = np.asarray(result.std_zero_offsets_user, float)
+    # the bound reported for each offset: the larger of the first-order bound and the exact model's at its worst
+    # corner, when the exact search ran (zerocal_sym.identify.bias_exact); its split by entry is first-order's
+    zo = bias.get("zero_offsets") or {}
+    worst = dict(zip(zo.get("names", ()), zo.get(f"worst_case_{unit}", ()))) if "names" in zo else {}
     out = []
     for j, name in enumerate(errors.zero_offsets):
         if name in rows:
@@ -85,7 +90,7 @@ def error_budget(bias: dict, result) -> dict:
         out.append({
             "name": name, "unit": unit,
             "noise_std": float(std[j]) if math.isfinite(std[j]) else None,
-            "robot_file_bias": float(np.sum(c)),
+            "robot_file_bias": max(float(np.sum(c)), float(worst.get(name) or 0.0)),
             "dominant_entries": [{"name": cols[k], "tolerance": float(t[k]),
                                   "unit": units_.get(cols[k], errors[cols[k]].user_unit),
                                   "sensitivity": float(s[k]), "contribution": float(c[k])} for k in order],

@@ -27,7 +27,9 @@ def format_compare(rep: dict) -> str:
         lines.append("")
         lines.append(f"group {g}: true offsets {_vec(go[k_set], '+.3f')} {u};  CRLB "
                      + ("n/a" if cr is None else f"{_vec(cr, '.4f')} {u}"))
-        offs = ",".join(f"dth{k + 1}" for k in range(m))
+        joints = list(s.get("truth", {}))[:m]  # the source errors by name, the zero offsets first
+        offs = ",".join(f"d{j}" for j in joints) if u != "deg" and len(joints) == m else \
+            ",".join(f"dth{k + 1}" for k in range(m))  # angles: dth1, dth2, ... (prismatic joints: ds1, dL1, ...)
         w = 11 * m
         lines.append(f"  {'method':10s} {'bias ' + offs + f' [{u}]':>{w}s} {'RMS ' + offs + f' [{u}]':>{w}s} "
                      f"{'RMS/CRLB':>{6 * m + 1}s} {'RMS rM [mm]':>{8 * m}s} {'dp0 RMS':>8s} {'fail':>4s} "

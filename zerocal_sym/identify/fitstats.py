@@ -142,6 +142,19 @@ def _fmt_p(p) -> str:
     return "p < 1e-300" if p == 0.0 else f"p = {p:.3g}"
 
 
+def chi2_test(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> tuple:
+    """The chi² test alone: ``(chi2, dof, checked, rejected, p_value, p_value_lower)`` (:func:`statistics`' verdict;
+    the p-values None where not checked: a zero noise model, no spare degree of freedom)."""
+    chi2 = float(lin.r @ lin.r) if lin.valid else float("inf")
+    dof = int(lin.dof)
+    if noise.is_zero or (lin.valid and dof <= 0):
+        return chi2, dof, False, False, None, None
+    if not lin.valid:
+        return chi2, dof, True, True, 0.0, 1.0
+    pl, p = _gamma_pq(0.5 * dof, 0.5 * chi2)   # lower and upper tails at once (chi2_cdf, chi2_sf)
+    return chi2, dof, True, bool(p < alpha), p, pl
+
+
 def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
     """The chi² test and the per-reading statistics of a linearised, whitened fit (JSON-ready dict).
 
@@ -152,14 +165,13 @@ def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
     ``worst`` (the reading with the largest ``|standardised|``, with the chi²
     and p-value without it), ``warnings``, ``noise``, ``model``.
     """
-    chi2 = float(lin.r @ lin.r) if lin.valid else float("inf")
-    dof = int(lin.dof)
+    chi2, dof, checked, rejected, p, pl = chi2_test(lin, noise, alpha)
     zero = noise.is_zero
     t, lev, delta, _ = lin.per_reading(moves=False)
     if not lin.valid:
         t[:], delta[:] = np.nan, np.nan
-    fit = {"model": "exact", "alpha": float(alpha), "chi2": chi2, "dof": dof, "p_value": None,
-           "p_value_lower": None, "checked": False, "reason": None, "rejected": False,
+    fit = {"model": "exact", "alpha": float(alpha), "chi2": chi2, "dof": dof, "p_value": p,
+           "p_value_lower": pl, "checked": checked, "reason": None, "rejected": rejected,
            "rms_whitened": float(math.sqrt(chi2 / dof)) if dof > 0 else None,
            "noise": _noise_dict(noise), "warnings": [], "accepted_despite_misfit": False}
     if zero:
@@ -168,18 +180,14 @@ def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
         if dof > 0:  # internally studentised: the noise level estimated from the residuals
             t = t / math.sqrt(chi2 / dof) if chi2 > 0 else t
     elif not lin.valid:
-        fit.update(checked=True, p_value=0.0, p_value_lower=1.0, rejected=True,
-                   reason="the exact model cannot be evaluated at the estimate (a pose is not an assembly of the "
-                          "robot with these errors): the estimate is nonsense")
+        fit["reason"] = ("the exact model cannot be evaluated at the estimate (a pose is not an assembly of the "
+                         "robot with these errors): the estimate is nonsense")
     elif dof <= 0:
         fit["reason"] = "the fit cannot be checked (no spare degrees of freedom)"
-    else:
-        pl, p = _gamma_pq(0.5 * dof, 0.5 * chi2)   # lower and upper tails at once (chi2_cdf, chi2_sf)
-        fit.update(checked=True, p_value=p, p_value_lower=pl, rejected=bool(p < alpha))
-        if pl < alpha:
-            fit["warnings"].append(
-                f"chi2 = {chi2:.4g} is far below its {dof} degrees of freedom (lower-tail {_fmt_p(pl)}): the "
-                "noise model overstates the noise, so the standard deviations are too large (conservative)")
+    elif pl < alpha:
+        fit["warnings"].append(
+            f"chi2 = {chi2:.4g} is far below its {dof} degrees of freedom (lower-tail {_fmt_p(pl)}): the "
+            "noise model overstates the noise, so the standard deviations are too large (conservative)")
     n = lin.n
     tt = np.where(np.isfinite(t), t, np.nan).tolist()
     dd = np.where(np.isfinite(delta), delta, np.nan).tolist()

@@ -30,6 +30,7 @@ import numpy as np
 
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model import units
 from zerocal_sym.model.noise import NoiseModel, geometry_error
 
 
@@ -204,6 +205,34 @@ def identifiability_report(robot, theta_cmd, params="paper", noise: NoiseModel |
         "identifiable": dict(zip(names, ident)),
         "crlb_std": dict(zip(names, crlb_std)),
     }
+
+
+def null_direction_text(robot, combination) -> str:
+    """A null direction (``identifiability_report``'s ``null_space`` entry) as amounts of the source errors in
+    file units, the largest 1: ``ddx = +1, rMx = +0.951, rMy = -0.255, rMz = +0.174 mm``."""
+    vals = [(t["param"], float(units.to_user(t["per_scaled_mm"], t["unit"])), robot.errors[t["param"]].user_unit)
+            for t in combination]
+    big = max(vals, key=lambda v: abs(v[1]))[1]
+    vals = [(n, v / big, u) for n, v, u in vals if abs(v / big) >= 1e-3]
+    parts = [f"{n} = {v:+.3g}" + (f" {u}" if k + 1 == len(vals) or vals[k + 1][2] != u else "")
+             for k, (n, v, u) in enumerate(vals)]
+    return ", ".join(parts)
+
+
+def null_space_phrase(robot, theta_cmd, names, err0=None) -> str:
+    """Why ``names`` are not identifiable from the poses: their null directions in file units (at most two
+    named; :func:`null_direction_text`), for a refusal's message."""
+    rep = identifiability_report(robot, theta_cmd, list(names), noise=NoiseModel(), err0=err0)
+    null = rep["null_space"]
+    if not null:
+        return ""
+    if rep["null_space_rigid"]:
+        motions = [label for labels in rep["null_space_gauge"] for label in labels]
+        return "the distances do not see the rigid motion(s) " + ", ".join(motions)
+    if len(null) > 2:
+        return f"{len(null)} combinations change no measured distance"
+    return ("this combination changes" if len(null) == 1 else "these combinations change") + \
+        " no measured distance: " + "; ".join(null_direction_text(robot, c) for c in null)
 
 
 def format_report(rep: dict) -> str:

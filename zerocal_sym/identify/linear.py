@@ -69,8 +69,8 @@ def identification_matrix(robot, P, maemm_prior=None, theta=None, params="defaul
     g = robot.geometry
     if maemm_prior is not None and np.any(np.asarray(maemm_prior, float) != 0):
         prior = np.asarray(maemm_prior, float)
-        shift = np.array([geometry_error(robot, errors.put(errors.zeros(), errors.measuring, v))
-                          for v in np.atleast_2d(prior)])
+        pr = np.atleast_2d(prior)
+        shift = geometry_error(robot, errors.put(np.zeros((pr.shape[0], len(errors))), errors.measuring, pr))
         g = g + (shift[0] if prior.ndim == 1 else shift)
     rows = kin.call(robot, "g_row", P, theta, g)[0][:, 0, :]
     lam = kin.call(robot, "measuring", P, g)[0][:, 0, 0]

@@ -235,7 +235,7 @@ def calibration_loop(robot, plant, poses, identify=identify_tsvd, noise=None, rn
 
 def calibration_loops(robot, plant, poses, identify_many, rngs, noise=None, mu0_deg=0.1, max_iter=20,
                       maemm_prior=None, run_all=False, kappa: bool = True, theta=None, firsts=None,
-                      catch=(Exception,)) -> list:
+                      catch=(Exception,), pass_loops: bool = False) -> list:
     """Several :func:`calibration_loop` in lockstep, each round's identifications in one call.
 
     Loop ``i`` is ``calibration_loop(robot, plant, poses, identify, noise,
@@ -256,6 +256,10 @@ def calibration_loops(robot, plant, poses, identify_many, rngs, noise=None, mu0_
         Each loop's first round (see ``first`` of :func:`calibration_loop`).
     catch : tuple of exception types
         Exceptions that end one loop (its entry is the exception); others propagate.
+    pass_loops : bool
+        Also pass the indices of the loops whose rounds these are:
+        ``identify_many(robot, rounds, priors, loops)`` (an identifier that keeps a state per loop: the
+        sequential MAP).
 
     Returns
     -------
@@ -289,7 +293,8 @@ def calibration_loops(robot, plant, poses, identify_many, rngs, noise=None, mu0_
     while pending:
         live = sorted(pending)
         t0 = time.perf_counter()
-        results = identify_many(robot, [pending[i][1] for i in live], [pending[i][2] for i in live])
+        args = (robot, [pending[i][1] for i in live], [pending[i][2] for i in live]) + ((live,) if pass_loops else ())
+        results = identify_many(*args)
         dt = (time.perf_counter() - t0) / len(live)
         for i, res in zip(live, results):
             calls[i] += 1

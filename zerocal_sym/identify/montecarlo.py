@@ -104,6 +104,11 @@ def _identity_report(values, which):
     return np.asarray(values, float)
 
 
+#: run the Ipopt loops of a chunk in lockstep (:class:`~zerocal_sym.identify.nlls_rounds.LoopRounds`); False: one
+#: loop after the other, each identification by ``identify_nlls`` (the same numbers: tests/test_compare_reference.py)
+NLLS_LOCKSTEP = True
+
+
 @dataclass
 class _CompareTask:
     """A chunk of trials of one truth (picklable: sent to worker processes)."""
@@ -150,6 +155,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
     """
     from zerocal_sym.identify.batch import identify_batch
     from zerocal_sym.identify.nlls import identify_nlls, make_nlls_identifier
+    from zerocal_sym.identify.nlls_rounds import LoopRounds
     from zerocal_sym.identify.tsvd import identify_tsvd_many
 
     robot, methods, names, noise = task.robot, task.methods, task.names, task.noise
@@ -191,10 +197,18 @@ def _compare_chunk(task: _CompareTask) -> dict:
         for loop, n_id, t_id in runs:
             loop = None if isinstance(loop, BaseException) else loop
             _record_loop(record, "tsvd-loop", loop, n_id, t_id, methods, paper4, errors)
-    for ss, meas1, after1 in trials:
-        for m in ("nlls-loop", "nlls-seq"):
-            if m not in methods:
-                continue
+    for m in ("nlls-loop", "nlls-seq"):
+        if m not in methods:
+            continue
+        if NLLS_LOCKSTEP:  # the chunk's Ipopt loops in lockstep, each round's identifications in one mapped call
+            runs = calibration_loops(robot, plant, task.poses, LoopRounds(names, noise, m == "nlls-seq"),
+                                     [_continued(ss, st) for ss, _, st in trials], firsts=[m1 for _, m1, _ in trials],
+                                     catch=(IdentificationError, ZerocalError), pass_loops=True, **loop_kw)
+            for loop, n_id, t_id in runs:
+                _record_loop(record, m, None if isinstance(loop, BaseException) else loop, n_id, t_id, methods,
+                             paper4, errors)
+            continue
+        for ss, meas1, after1 in trials:  # one loop after the other (the same numbers)
             ident = _Timed(make_nlls_identifier(params=names, noise=noise, sequential=(m == "nlls-seq")))
             try:
                 loop = calibration_loop(robot, plant, task.poses, identify=ident, rng=_continued(ss, after1),
@@ -202,6 +216,7 @@ def _compare_chunk(task: _CompareTask) -> dict:
             except (IdentificationError, ZerocalError):
                 loop = None
             _record_loop(record, m, loop, ident.n, ident.t, methods, paper4, errors)
+    for ss, meas1, after1 in trials:
         if "nlls" in methods:
             first.append(meas1.readings)
         if "scipy" in methods:

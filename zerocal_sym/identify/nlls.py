@@ -53,7 +53,6 @@ from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, in
 from zerocal_sym.identify.nlls_banded import round_problem
 from zerocal_sym.identify.nlls_problem import get_problem
 from zerocal_sym.identify.nlls_solve import UNIT_SIGMA_MM, information, robust_stage, solve, status_line
-from zerocal_sym.model.fastcall import FastCall
 from zerocal_sym.identify.result import IdentificationResult
 
 #: losses of identify_nlls (robust ones: zerocal_sym.identify.robust)
@@ -137,11 +136,15 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         despite misfit ...").
 
     Solution: ``N_GN`` damped Gauss-Newton iterations inside one CasADi
-    call (:mod:`zerocal_sym.identify.nlls_problem`), then one Ipopt solve from
-    that point, whose status decides ``success`` (Ipopt is the judge; from a
-    converged Gauss-Newton point it takes 0-1 iterations).  If Gauss-Newton
-    did not converge (or left the bounds) Ipopt starts at the start point
-    and, with ``reweight``, solves once more with the weights at its solution.
+    call (:mod:`zerocal_sym.identify.nlls_problem`), then Ipopt's verdict on
+    that point, whose status decides ``success`` (Ipopt is the judge): a
+    converged point without bounds that passes Ipopt's own termination test
+    at a start (:func:`~zerocal_sym.identify.nlls_solve.ipopt_accepts`, on
+    the Jacobian and residuals already computed) gets what Ipopt returns
+    there (``Solve_Succeeded``, 0 iterations); otherwise Ipopt solves from it
+    (0-1 iterations from a converged point).  If Gauss-Newton did not
+    converge (or left the bounds) Ipopt starts at the start point and, with
+    ``reweight``, solves once more with the weights at its solution.
 
     Returns
     -------
@@ -149,7 +152,8 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         ``method = "nlls"``; ``success`` False whenever Ipopt did not
         converge (``status`` says why) and when the fit check rejects the fit;
         ``info``: ``solver_status``, ``iterations``, ``cost``, ``chi2``,
-        ``dof``, ``time_s``, ``weighting``, ``warm_start``, ``rank``,
+        ``dof``, ``time_s``, ``weighting``, ``warm_start``, ``confirmation``
+        (``"first-order test"`` or ``"ipopt"``), ``rank``,
         ``singular_values`` (of the scaled whitened Jacobian),
         ``nonidentifiable``, ``fit`` (the fit check), ``robust`` (with a
         robust loss).  ``std_kind``: ``"total"`` (the Cramér-Rao bound at the
@@ -224,6 +228,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         "noise": _noise_dict(noise),
         "warm_start": start,
         "gauss_newton": {"converged": sol.gn_ok, "last_step_mm": sol.step},
+        "confirmation": sol.confirmation,
         "initial": x0.tolist(),
         "rank": rank,
         "singular_values": sv.tolist(),
@@ -358,19 +363,29 @@ def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequen
 
     def identify(robot, meas, prior=None):
         kw = dict(kwargs)
-        last = state["last"]
-        if sequential and last is not None and prior is not None and last.success:
-            full = last.full_vector()
-            idx = robot.errors.indices(params)
-            if np.allclose(np.asarray(prior, float)[idx], full[idx], rtol=0, atol=1e-15) \
-                    and last.covariance is not None and np.all(np.isfinite(last.covariance)):
-                kw["prior_cov"] = last.covariance
+        cov = sequential_prior_cov(robot, params, state["last"], prior) if sequential else None
+        if cov is not None:
+            kw["prior_cov"] = cov
         res = identify_nlls(robot, meas, params=params, noise=noise, prior=prior, **kw)
         state["last"] = res
         return res
 
     identify.__name__ = f"nlls[{params}]" + ("-sequential" if sequential else "")
     return identify
+
+
+def sequential_prior_cov(robot, params, last, prior):
+    """The Gaussian prior a sequential MAP takes from the previous result ``last`` of its loop: its covariance,
+    when ``prior`` is that result's own estimate (as the calibration loop passes it) and it is a finite
+    calibration; else None."""
+    if last is None or prior is None or not last.success:
+        return None
+    full = last.full_vector()
+    idx = robot.errors.indices(params)
+    if np.allclose(np.asarray(prior, float)[idx], full[idx], rtol=0, atol=1e-15) \
+            and last.covariance is not None and np.all(np.isfinite(last.covariance)):
+        return last.covariance
+    return None
 
 
 def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
@@ -405,15 +420,15 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
     prob = get_problem(robot, theta_cmd.shape[0], names)
     par = prob.pack(theta_cmd, robot.geometry, prior_q, np.asarray(meas.readings, float)[1:], scale,
                     errors.take(prior_q, names), np.zeros((len(names), len(names))), *noise_terms(noise))
-    fs = prob.functions
-    l, b = (o.full().ravel() for o in fs["weights"](errors.take(prior_q, names) * scale, par))
+    fast = prob.fast
+    l, b = (np.array(o) for o in fast["weights"](errors.take(prior_q, names) * scale, par))
     if callbacks not in ("plain", "fast"):
         raise ValueError(f"callbacks must be 'plain' or 'fast', got {callbacks!r}")
     if callbacks == "fast":
-        rfun, jfun = FastCall(fs["rfun"]), FastCall(fs["jfun"])
+        rfun, jfun = fast["rfun"], fast["jfun"]  # (one buffer per thread, outputs copied)
         fun, jac = (lambda z: rfun(z, par, l, b)[0].copy()), (lambda z: jfun(z, par, l, b)[0].copy())
     else:
-        rfun, jfun = fs["rfun"], fs["jfun"]
+        rfun, jfun = prob.functions["rfun"], prob.functions["jfun"]
         fun, jac = (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full())
     if noise.has_shared and not noise.is_zero:  # the full covariance at the prior: W L0 (L0 r = the residuals)
         from zerocal_sym.identify import banded

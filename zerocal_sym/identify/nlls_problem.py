@@ -284,7 +284,7 @@ class NllsProblem:
             fs = self.tier.get()
             self._fast = {name: FastCall(fs[name])
                           for name in ("gauss_newton", "gauss_newton_fixed", "weights", "residuals", "jfun",
-                                       "fit_terms") if name in fs}
+                                       "rfun", "fit_terms") if name in fs}
             self._solvers, self._batch = {}, {}
             self._version = self.tier.version
         return self.tier.get()
@@ -357,11 +357,31 @@ class NllsProblem:
         return [np.array(o) for o in out]
 
     def batch(self, N: int) -> FastCall:
-        """``gauss_newton`` mapped over N data sets (columns of z0 and of the parameter vector), zero-copy."""
+        """``gauss_newton`` mapped over ``batch_size(N)`` data sets (columns of z0 and of the parameter vector),
+        zero-copy: one Function per power of two, not one per N (:meth:`run_batch` pads the columns)."""
         fs = self._sync()
+        N = batch_size(N)
         if N not in self._batch:
             self._batch[N] = FastCall(fs["gauss_newton"].map(N))
         return self._batch[N]
+
+    def run_batch(self, z0, P) -> list:
+        """One block of Gauss-Newton over the n columns of ``z0`` (p, n) and ``P`` (npar, n), each column as
+        ``gauss_newton`` alone (the mapped Function evaluates every column the same way, whatever their
+        number); the columns are padded to :func:`batch_size` with copies of the first.
+
+        Returns copies of the outputs for the n columns: ``z`` (p, n), ``last_step`` (1, n), ``r`` (K-1, n),
+        ``r_prior`` (p, n), ``J`` (K-1 + p, p n: ``[J_1 | J_2 | ...]``), ``pred`` (K-1, n), ``l`` (K-1, n),
+        ``b`` (K-2, n).
+        """
+        n = z0.shape[1]
+        N = batch_size(n)
+        if N > n:
+            z0 = np.concatenate([z0, np.repeat(z0[:, :1], N - n, axis=1)], axis=1)
+            P = np.concatenate([P, np.repeat(P[:, :1], N - n, axis=1)], axis=1)
+        out = self.batch(N)(z0, P)
+        width = [self.p if k == 4 else 1 for k in range(len(out))]
+        return [np.array(np.reshape(o, (-1, N * w), order="F")[:, : n * w], order="F") for o, w in zip(out, width)]
 
     def pack(self, theta_cmd, geometry, err_fixed, s, scale, mu, w, sm2, sx2):
         """The parameter vector, shape (npar,).
@@ -375,6 +395,11 @@ class NllsProblem:
         """Where the K-1 changes sit in the parameter vector."""
         start = self.m * self.K + G + q
         return slice(start, start + self.K - 1)
+
+
+def batch_size(n: int) -> int:
+    """The size of the mapped Function that serves n data sets: the next power of two (1, 2, 4, ...)."""
+    return 1 << max(0, int(n) - 1).bit_length()
 
 
 def get_problem(robot, K: int, params="paper") -> NllsProblem:

@@ -1,7 +1,8 @@
 """The stages of :func:`~zerocal_sym.identify.nlls.identify_nlls` after its inputs are checked.
 
-:func:`solve` (Gauss-Newton inside one CasADi call, then Ipopt, whose status
-decides), :func:`robust_stage` (a robust loss from the l2 solution),
+:func:`solve` (Gauss-Newton inside one CasADi call, then Ipopt's verdict:
+its own termination test at a converged Gauss-Newton point, or its solve),
+:func:`robust_stage` (a robust loss from the l2 solution),
 :func:`information` (rank, covariance and null space from one SVD of the
 whitened, scaled Jacobian) and :func:`status_line`.  Shapes: K poses, p
 estimated parameters.
@@ -21,25 +22,65 @@ UNIT_SIGMA_MM = 1e-3
 CONVERGED_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 #: Gauss-Newton is converged when its last step is below this (scaled units, mm)
 GN_STEP_TOL = 1e-8
+#: how a converged Gauss-Newton point is confirmed: ``"test"`` -- Ipopt's own termination test at its starting
+#: point (:func:`ipopt_accepts`), evaluated on the Jacobian and residuals Gauss-Newton returned, Ipopt solving
+#: whenever it does not pass; ``"ipopt"`` -- Ipopt solves every time (the tests compare the two)
+CONFIRM = "test"
+#: the test passes when Ipopt's optimality error at the point is below this fraction of Ipopt's tolerance: the
+#: gradient here (numpy, from J and r) and Ipopt's (CasADi's reverse mode) differ by round-off, far below it
+CONFIRM_MARGIN = 0.5
+
+
+def ipopt_accepts(J, r, rp, K) -> bool:
+    """Would Ipopt, started at this point, stop there at once (``Solve_Succeeded`` after 0 iterations)?
+
+    Ipopt's NLP here (:mod:`~zerocal_sym.identify.nlls_problem`) is unconstrained, without bounds, unscaled
+    (``nlp_scaling_method none``), with the objective ``0.5 c |[r; rp]|^2``, ``c = 1 / |J_data|_F^2``.  At its
+    starting point, before any iteration, Ipopt checks convergence first (before its iteration limit): with
+    no constraints, bounds or multipliers its optimality error is the largest entry of the gradient
+    ``c J^T [r; rp]`` (the dual infeasibility, its scaling factor 1), and it stops with ``Solve_Succeeded``,
+    the point unchanged, when that is at most ``ipopt.tol``.  This is that test, with the margin
+    :data:`CONFIRM_MARGIN`; ``J`` (K-1 + p, p), ``r`` (K-1,), ``rp`` (p,).
+    """
+    from zerocal_sym.identify.nlls_problem import IPOPT_OPTIONS
+
+    Jd = J[: K - 1]
+    c = 1.0 / max(1e-300, float(np.vdot(Jd, Jd)))
+    g = c * (J.T @ np.concatenate([r, rp]))
+    err = float(np.max(np.abs(g))) if g.size else 0.0
+    return bool(np.isfinite(err) and err <= CONFIRM_MARGIN * IPOPT_OPTIONS["ipopt.tol"])
 
 
 def solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleNamespace:
-    """Gauss-Newton in one CasADi call, then Ipopt from its point: Ipopt's status decides.
+    """Gauss-Newton in one CasADi call, then Ipopt's verdict on its point: Ipopt's status decides.
 
-    If Gauss-Newton did not converge (or left the bounds) Ipopt starts at
-    ``z0`` and, with ``reweight``, solves once more with the weights at its
-    solution.  Returns ``z`` (p,), ``ret`` (Ipopt's status), ``converged``,
-    ``iterations`` (Ipopt's), ``gn_ok``, ``step`` (Gauss-Newton's last, mm)
-    and, at the final point, the weights ``l`` (K-1,), ``b`` (K-2,), the
-    whitened residuals ``r`` (K-1,) and prior residuals ``rp``, the Jacobian
-    ``J`` (K-1 + p, p) and the predicted changes ``pred`` (K-1,).
+    A converged Gauss-Newton point without bounds is first put to Ipopt's own
+    termination test at a starting point (:func:`ipopt_accepts`, on the
+    Jacobian and residuals already computed): when it passes, the result is
+    what Ipopt returns there (``Solve_Succeeded``, 0 iterations, the point
+    unchanged) without calling it; otherwise (or with bounds, which Ipopt
+    moves a start away from, or :data:`CONFIRM` ``"ipopt"``) Ipopt solves from
+    that point.  If Gauss-Newton did not converge (or left the bounds) Ipopt
+    starts at ``z0`` and, with ``reweight``, solves once more with the weights
+    at its solution.  Returns ``z`` (p,), ``ret`` (Ipopt's status),
+    ``converged``, ``iterations`` (Ipopt's), ``gn_ok``, ``step``
+    (Gauss-Newton's last, mm), ``confirmation`` (``"first-order test"`` or
+    ``"ipopt"``) and, at the final point, the weights ``l`` (K-1,), ``b``
+    (K-2,), the whitened residuals ``r`` (K-1,) and prior residuals ``rp``,
+    the Jacobian ``J`` (K-1 + p, p) and the predicted changes ``pred`` (K-1,).
     """
-    solver = prob.solver_for(max_iter)
     fast = prob.fast
     z_gn, step, r, rp, J, pred, l, b = prob.run_gauss_newton(z0, par, bool(reweight), GN_STEP_TOL)
     step = float(step[0])
     gn_ok = bool(np.isfinite(z_gn).all() and step < GN_STEP_TOL
                  and (not bounded or (np.all(z_gn >= lbx) and np.all(z_gn <= ubx))))
+    if gn_ok and not bounded and CONFIRM == "test":
+        r, rp, pred = r.ravel(), rp.ravel(), pred.ravel()
+        J = np.reshape(J, (-1, z_gn.size))
+        if ipopt_accepts(J, r, rp, K):
+            return SimpleNamespace(z=z_gn, ret="Solve_Succeeded", converged=True, iterations=0, gn_ok=True,
+                                   step=step, l=l, b=b, r=r, rp=rp, J=J, pred=pred, confirmation="first-order test")
+    solver = prob.solver_for(max_iter)
     if gn_ok:  # Ipopt confirms the Gauss-Newton point (weights at that point)
         z, passes = z_gn, 1
     else:      # Ipopt from the start; with reweight once more with the weights at its solution
@@ -64,7 +105,8 @@ def solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleName
         r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
     return SimpleNamespace(z=z, ret=ret, converged=ret in CONVERGED_STATUSES and bool(np.isfinite(z).all()),
                            iterations=total_iter, gn_ok=gn_ok, step=step, l=l, b=b, r=r.ravel(), rp=rp.ravel(),
-                           J=np.reshape(J, (-1, z.size)), pred=pred.ravel())  # (a column when p = 1)
+                           J=np.reshape(J, (-1, z.size)), pred=pred.ravel(),  # (a column when p = 1)
+                           confirmation="ipopt")
 
 
 def robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w, z_prior, K):

@@ -46,7 +46,10 @@ class IdentificationResult(units.DegreeViews):
         method knows of: the noise through the model, and for TSVD its
         linearisation bias and the truncated directions' bias bound),
         ``"from residuals"`` (no noise model: the noise level estimated from
-        the residuals), ``"lower bound"`` (a known contribution could not be
+        the residuals), ``"bound"`` (TSVD: the std of at least one parameter is
+        an upper bound, its linearisation bias not small or not well
+        determined; ``info["std_kinds"]`` per parameter, ``to_dict()["std_kinds"]``),
+        ``"lower bound"`` (a known contribution could not be
         evaluated; ``info`` says which).  Unmodelled source errors are in none
         of them: the fit check (``info["fit"]``) is the guard against those.
     """
@@ -132,6 +135,8 @@ class IdentificationResult(units.DegreeViews):
             "covariance_units": "rad for angles, mm otherwise (SI-like internal units)",
             "residuals_mm": np.asarray(self.residuals).tolist(),
             "std_kind": self.std_kind,
+            "std_kinds": dict(self.info["std_kinds"]) if isinstance(self.info, dict) and "std_kinds" in self.info
+            else {n: self.std_kind for n in self.params},
             "fit": _json_ready(self.info.get("fit")) if isinstance(self.info, dict) else None,
             **({"revisits": _json_ready(self.info["revisits"])}
                if isinstance(self.info, dict) and "revisits" in self.info else {}),

@@ -141,23 +141,22 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     Returns
     -------
     IdentificationResult
-        ``method = "tsvd"``, params: the zero offsets and the MAEMM.  ``covariance``
-        is that of the linear TSVD estimator ``x = A b`` (``A = V_t S_t^-1
-        U_t^T``) under the noise model, ``T A C A^T T`` with ``C`` the
-        covariance of the measured changes (:func:`zerocal_sym.identify.fisher.
-        measurement_covariance`, servo error propagated to first order) and
-        ``T`` converting ``L dth`` to ``dth``.  Without a noise model it is
-        ``s^2 T A A^T T`` with ``s^2 = ||r||^2 / (K - 1 - t)`` (white noise
-        estimated from the linear residuals), or None if ``K - 1 = t``.
-        **What TSVD leaves out is added** (``std_kind = "total"``, or
-        ``"from residuals"`` without a noise model): the linearisation bias
-        ``b = estimate - (exact-model minimum over the kept directions, Gauss-
-        Newton from the estimate)`` as ``b b^T``, and for each truncated
-        direction ``v_i`` a bias bound ``(|c_i| + 2 sd_i)^2 T v_i v_i^T T``
-        (``c_i`` its component in the full-rank exact fit, ``sd_i`` that
-        component's std); if these cannot be evaluated the std is labelled
-        ``"lower bound"``.  ``info["covariance_noise"]`` is the noise part
-        alone, ``info["std_components"]`` the three parts per parameter.
+        ``method = "tsvd"``, params: the zero offsets and the MAEMM.  ``covariance``:
+        the noise of the linear TSVD estimator ``x = A b`` (``A = T V_t S_t^-1 U_t^T``,
+        ``T`` converting ``L dth`` to ``dth``), ``A C A^T`` with ``C`` the covariance
+        of the changes at the estimate (without a noise model ``s^2 A A^T``,
+        ``s^2 = ||r||^2 / (K - 1 - t)``, or None if ``K - 1 = t``), and **what TSVD
+        leaves out**, per parameter (:mod:`~zerocal_sym.identify.tsvd_uncertainty`):
+        its linearisation bias ``b`` (``x - t*``, ``t*`` the truth its noise-free
+        data maps onto the estimate) and, for each truncated direction, a bias
+        bound; ``info["std_kinds"]`` says per
+        parameter whether its std is honest (``"total"``: ``noise^2 + b^2``,
+        the bias small and well determined) or an upper bound (``"bound"``);
+        ``std_kind`` is ``"total"`` when all are, else ``"bound"`` (``"from
+        residuals"`` without a noise model, ``"lower bound"`` if a part cannot
+        be evaluated, with ``info["std_note"]``).  ``info["covariance_noise"]``
+        is the noise part alone, ``info["std_components"]`` the parts per
+        parameter.
         ``residuals`` are the measured minus the exact-model changes at the
         estimate.  ``info``: ``singular_values``, ``truncation``,
         ``filter_factors``, ``rule``, ``kappa``, ``linear_residuals``,
@@ -195,10 +194,14 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     b = readings[1:] - np.diff(lam)
     s = np.linalg.svd(G, compute_uv=False)
     if s[-1] <= RANK_RTOL * s[0]:
+        from zerocal_sym.identify.identifiability import null_space_phrase
+
         rank = int(np.sum(s > RANK_RTOL * s[0]))
+        why = null_space_phrase(robot, th, names, err0=prior)
         raise IdentificationError(
-            f"identification matrix G has rank {rank} < {p}: the measuring-mechanism vectors of the poses "
-            "are degenerate, the offsets and the MAEMM cannot be identified", where=meas.source)
+            f"identification matrix G has rank {rank} < {p}: the offsets and the MAEMM cannot be identified from "
+            f"these poses ({why or 'the measuring-mechanism vectors of the poses are degenerate'}); measure other "
+            "poses", where=meas.source)
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if spread[1] <= COLLINEAR_RTOL * spread[0]:
         raise IdentificationError(
@@ -220,8 +223,9 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     lin_res = b - G @ sol.x
     A = T @ sol.operator()
     m = G.shape[0]
-    if C is not None:
-        cov = C.sandwich(A)  # A C A^T from the bands, O(K p^2)
+    base = errors.put(errors.zeros(), offs + maemm, errors.take(prior, offs + maemm))  # what TSVD's model holds
+    if C is not None:  # the servo error through the exact model at the estimate
+        cov = change_covariance(robot, th, noise, err0=errors.put(base, names, est)).sandwich(A)  # A C A^T, O(K p^2)
     elif m > sol.t:
         cov = float(lin_res @ lin_res) / (m - sol.t) * (A @ A.T)
     else:
@@ -230,7 +234,7 @@ def _identify_tsvd(robot, meas, prior=None, t=None, rule=DEFAULT_RULE, noise=Non
     pred = np.diff(kin.distance(robot, th, full))
     residuals = np.asarray(meas.readings, float)[1:] - pred
     honest = _honest_uncertainty(robot, meas, names, errors.put(errors.zeros(), names, errors.take(prior, names)),
-                                 noise, est, sol, cov)
+                                 noise, est, sol, cov, A=A, base=base)
     items = list(info.items())  # the keys in their documented order: linear_residuals after kappa
     info = dict(items[:5] + [("linear_residuals", lin_res)] + items[5:])
     info.update({k: v for k, v in honest.items() if not k.startswith("_")})
@@ -306,7 +310,7 @@ def _lean(errors, names, est, status, info):
                                 errors=errors, std_kind="lower bound")
 
 
-def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL) -> list:
+def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rtol=DEFAULT_RTOL, noise=None) -> list:
     """``identify_tsvd(robot, meas, prior, t=t, rule=rule, rtol=rtol, diagnostics=False)`` of many rounds at once.
 
     The kinematics, identification matrices and SVDs of all rounds (with
@@ -324,6 +328,11 @@ def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rt
         One per round (default: all zero).
     t, rule, rtol
         As :func:`identify_tsvd` (no noise model: not the ``discrepancy`` rule).
+    noise : NoiseModel, optional
+        With it each result carries its std as :func:`identify_tsvd` computes it (``covariance``,
+        ``std_kind``, ``info["std_kinds"]``, ``info["linearisation_bias"]``, ...;
+        :func:`~zerocal_sym.identify.tsvd_uncertainty.attach_std_many`), still without the fit check; a
+        truncated round (``t < p``) is identified alone, with diagnostics and ``fit_alpha=0``.
 
     Returns
     -------
@@ -342,7 +351,8 @@ def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rt
 
     def alone(i):
         try:
-            out[i] = identify_tsvd(robot, rounds[i], priors[i], t=t, rule=rule, rtol=rtol, diagnostics=False)
+            out[i] = identify_tsvd(robot, rounds[i], priors[i], t=t, rule=rule, rtol=rtol, noise=noise,
+                                   diagnostics=noise is not None, fit_alpha=0.0)
         except Exception as exc:  # noqa: BLE001 - handed back as that round's outcome
             _raise_if_interrupt(exc)
             out[i] = exc
@@ -371,46 +381,53 @@ def identify_tsvd_many(robot, rounds, priors=None, t=None, rule=DEFAULT_RULE, rt
         else:
             alone(i)
     for K, items in groups.items():
+        keys = {}  # the kinematics, G and its SVD once per distinct (poses, prior): rounds of one design share them
+        u = np.array([keys.setdefault((th.tobytes(), prior.tobytes()), len(keys)) for _, th, _, prior in items])
+        first = [items[j] for j in np.unique(u, return_index=True)[1]]
         try:
-            P = kin.fk(robot, np.concatenate([th + prior[i_off] for _, th, _, prior in items]))
-            fin = np.isfinite(P).reshape(len(items), -1).all(axis=1)
-            for (i, *_), f in zip(items, fin):
-                if not f:
-                    alone(i)
-            items = [it for it, f in zip(items, fin) if f]
-            if not items:
-                continue
-            N = len(items)
-            P = P.reshape(-1, K, P.shape[1])[fin].reshape(N * K, -1)
-            mp = [prior[i_meas] for *_, prior in items]
-            G, lam = identification_matrix(robot, P, maemm_prior=np.repeat(mp, K, axis=0))
-            G = G[(np.arange(N)[:, None] * K + np.arange(K - 1)).ravel()].reshape(N, K - 1, p)
-            lam = lam.reshape(N, K)
-            B = np.array([rd for _, _, rd, _ in items])[:, 1:] - np.diff(lam, axis=1)
+            P = kin.fk(robot, np.concatenate([th + prior[i_off] for _, th, _, prior in first]))
+            fin = np.isfinite(P).reshape(len(first), -1).all(axis=1)  # a round with an unreachable pose: alone
+            sel = np.flatnonzero(fin)
+            Nu = sel.size
+            P3 = P.reshape(len(first), K, -1)[sel]
+            mp = [first[j][3][i_meas] for j in sel]
+            G, lam = identification_matrix(robot, P3.reshape(Nu * K, -1), maemm_prior=np.repeat(mp, K, axis=0))
+            G = G[(np.arange(Nu)[:, None] * K + np.arange(K - 1)).ravel()].reshape(Nu, K - 1, p)
+            lam = lam.reshape(Nu, K)
             S = np.linalg.svd(G, compute_uv=False)
-            P3 = P.reshape(N, K, -1)
             spread = np.linalg.svd(P3 - P3.mean(axis=1, keepdims=True), compute_uv=False)
             good = ((S[:, -1] > RANK_RTOL * S[:, 0]) & (spread[:, 1] > COLLINEAR_RTOL * spread[:, 0])
-                    & np.isfinite(G).reshape(N, -1).all(axis=1) & np.isfinite(B).all(axis=1))
-            U, S2, Vt = np.linalg.svd(G[good], full_matrices=False)
+                    & np.isfinite(G).reshape(Nu, -1).all(axis=1))
+            U, S2, Vt = np.linalg.svd(G[good], full_matrices=False) if good.any() else (None,) * 3
+            at = np.cumsum(good) - 1  # position of a good G among the SVDs
+            u = np.where(fin, np.cumsum(fin) - 1, -1)[u]  # each round's row among the finite distinct ones
         except Exception as exc:  # noqa: BLE001 - e.g. an unreachable pose: each round alone says which
             _raise_if_interrupt(exc)
             for i, *_ in items:
                 alone(i)
             continue
-        k = 0
-        for j, (i, th, rd, prior) in enumerate(items):
-            if not good[j]:
+        pending = []  # rounds whose std is computed together (a noise model given)
+        for (i, th, rd, prior), j in zip(items, u):
+            b = rd[1:] - np.diff(lam[j]) if j >= 0 else None
+            if j < 0 or not (good[j] and np.isfinite(b).all()):
                 alone(i)
                 continue
+            k = at[j]
             try:
-                sol = _solve_svd(U[k], S2[k], Vt[k], B[j], K - 1, t, rule, rtol, None, 1.0)
+                sol = _solve_svd(U[k], S2[k], Vt[k], b, K - 1, t, rule, rtol, None, 1.0)
             except Exception as exc:  # noqa: BLE001 - alone, it raises the same
                 _raise_if_interrupt(exc)
                 alone(i)
-                k += 1
                 continue
-            k += 1
+            if noise is not None and sol.t < p:  # the truncated directions' bound needs the exact fits: alone
+                alone(i)
+                continue
             _, est, status, info = _estimate(errors, names, prior, sol, S[j], T, P3[j], mp[j])
             out[i] = _lean(errors, names, est, status, info)
+            if noise is not None:
+                pending.append((out[i], th, rd, T @ sol.operator(), prior))
+        if pending:
+            from zerocal_sym.identify.tsvd_uncertainty import attach_std_many
+
+            attach_std_many(robot, pending, noise)
     return out

@@ -38,7 +38,8 @@ class ColumnMismatch(DataFileError):
 MECHANISM_KEY = "mechanism"
 #: the metadata keys zerocal reads: one value each (a second line with another value is an error); other
 #: ``# key: value`` lines are kept and ignored, and may repeat
-READ_META_KEYS = (MECHANISM_KEY, "robot_sha256", "compensation_deg", "true_errors", "revisits")
+READ_META_KEYS = (MECHANISM_KEY, "robot_sha256", "compensation_deg", "compensation_mm", "true_errors", "revisits",
+                  "region", "region_singularity_margin")
 #: metadata key (a CSV's ``# revisits: allowed``, a JSON pose file's ``"revisits": "allowed"``) saying the file
 #: revisits poses on purpose (a design's replicates); its one value
 REVISITS_KEY, REVISITS_ALLOWED = "revisits", "allowed"

@@ -10,7 +10,8 @@
   file's ``# revisits: allowed`` line, or ``allow_revisits``: the CLI's
   ``--allow-revisits``);
 * :func:`check_against_robot` -- every commanded pose reachable and inside
-  the workspace (within :data:`WORKSPACE_TOL_MM`), the targets within
+  the workspace (within :data:`WORKSPACE_TOL_MM`; a compensated round's
+  commands with its ``# compensation_deg:`` undone), the targets within
   :data:`TARGET_TOL_MM` of where the commanded angles lead, the
   ``robot_sha256`` line.
 
@@ -40,6 +41,44 @@ TARGET_TOL_MM = 50.0
 DUPLICATE_TOL_DEG = REVISIT_TOL
 
 
+#: the metadata of a round on a design's own region (``zerocal design --region``): its poses may leave the
+#: workspace; they are checked for reachability, the assembly mode and this singularity margin instead
+REGION_KEYS = ("region", "region_singularity_margin")
+
+
+def region_of(meta) -> dict | None:
+    """``{"region": ..., "region_singularity_margin": float}`` of a round on a design's region, or None."""
+    if meta.get("region") is None:
+        return None
+    return {"region": meta["region"], "region_singularity_margin": float(meta["region_singularity_margin"])}
+
+
+def check_region_poses(robot, P, region: dict, where) -> np.ndarray:
+    """Poses of a design's region: reachable, in the home assembly mode (FK returns them, 1e-6 mm), at least the
+    region's singularity margin from a singular configuration.  ``where(k)``: the place of pose k in messages.
+
+    Returns the joints IK(P), shape (K, m); DataFileError naming the first pose that is not.
+    """
+    from zerocal_sym.errors import PoseError
+    from zerocal_sym.model import kinematics as kin
+
+    margin = region["region_singularity_margin"]
+    try:
+        theta = kin.check_poses(robot, P, margin=margin)
+    except PoseError as exc:
+        k = int(exc.where.split()[-1]) if exc.where and exc.where.startswith("pose ") else 0
+        raise DataFileError(f"pose {k} of the design's region ({region['region']}): {exc.message}",
+                            where=where(k)) from None
+    with np.errstate(all="ignore"):
+        back = kin.fk(robot, theta)
+    bad = np.flatnonzero(~(np.linalg.norm(back - P, axis=1) <= 1e-6))
+    if bad.size:
+        k = int(bad[0])
+        raise DataFileError(f"pose {k} {kin.fmt_user_pose(robot, P[k])} of the design's region ({region['region']}) "
+                            "is in another assembly mode: the forward kinematics do not return it", where=where(k))
+    return theta
+
+
 def _check_metadata(meta, meta_lines, src, mech) -> None:
     """The values of the metadata lines zerocal reads, each of the right form (DataFileError naming the line)."""
     from zerocal_sym.io.compensation import parse_offsets
@@ -53,6 +92,19 @@ def _check_metadata(meta, meta_lines, src, mech) -> None:
     if rv is not None and rv != REVISITS_ALLOWED:
         raise DataFileError(f"'# {REVISITS_KEY}:' can only be '{REVISITS_ALLOWED}' (the file revisits poses on "
                             f"purpose), got {rv[:80]!r}", where=f"{src}:{meta_lines[REVISITS_KEY]}")
+    if (meta.get("region") is None) != (meta.get("region_singularity_margin") is None):
+        given = "region" if meta.get("region") is not None else "region_singularity_margin"
+        raise DataFileError("'# region:' and '# region_singularity_margin:' go together (a round on a design's "
+                            "region names both)", where=f"{src}:{meta_lines[given]}")
+    margin = meta.get("region_singularity_margin")
+    if margin is not None:
+        try:
+            ok = 0 <= float(margin) < 1
+        except ValueError:
+            ok = False
+        if not ok:
+            raise DataFileError(f"'# region_singularity_margin:' must be a number in [0, 1), got {margin[:80]!r}",
+                                where=f"{src}:{meta_lines['region_singularity_margin']}")
     key = units.joint_key(mech, "compensation")
     comp = meta.get(key)
     if comp is not None and parse_offsets(comp, mech.m) is None:
@@ -166,14 +218,22 @@ def check_against_robot(meas: Measurements, robot) -> None:
             f"measured on another robot: robot_sha256 {sha[:12]}... in the file, {robot.sha256[:12]}... for "
             f"{robot.source} (pass the right --robot, or delete the line if the geometry is the same)",
             where=f"{meas.source}:{line}" if line else meas.source)
+    from zerocal_sym.io.compensation import parse_offsets
+
+    # a compensated round (its '# compensation_deg:' line): the commands are IK(target) - compensation, so the
+    # pose they were meant for, the one checked, is where the commands plus the compensation lead
+    comp = parse_offsets(meas.meta.get(units.joint_key(robot, "compensation")), robot.m)
+    intended = meas.theta_cmd if comp is None else meas.theta_cmd + units.joints_from_user(robot, comp)
     with np.errstate(all="ignore"):
-        P = kin.fk(robot, meas.theta_cmd)
+        P = kin.fk(robot, intended)
     ws = robot.workspace
+    region = region_of(meas.meta)  # a design's own region: its poses may leave the workspace (checked below)
+    contains = ws.contains if region is None else (lambda X, tol: np.ones(len(X), bool))
     target_what = f"target ({', '.join(cols.pose)})"
     with np.errstate(invalid="ignore"):  # all poses at once; the first bad one is reported below
-        bad = ~np.all(np.isfinite(P), axis=1) | ~ws.contains(P, WORKSPACE_TOL_MM)
+        bad = ~np.all(np.isfinite(P), axis=1) | ~contains(P, WORKSPACE_TOL_MM)
         if meas.target is not None:
-            bad |= ~ws.contains(meas.target, 1e-6) | ~(np.linalg.norm(P - meas.target, axis=1) <= TARGET_TOL_MM)
+            bad |= ~contains(meas.target, 1e-6) | ~(np.linalg.norm(P - meas.target, axis=1) <= TARGET_TOL_MM)
     for k in map(int, np.flatnonzero(bad)[:1]):
         if not np.all(np.isfinite(P[k])):
             ju = robot.mechanism.joint_user_unit
@@ -181,11 +241,12 @@ def check_against_robot(meas: Measurements, robot) -> None:
                                 f"{fmt_pose(units.joints_to_user(robot, meas.theta_cmd[k]))} {ju} are not an "
                                 f"assembly of the robot (unreachable pose; {units.unit_hint(robot)})",
                                 where=meas.where(k))
-        pts = [("commanded", P[k], WORKSPACE_TOL_MM)]
+        pts = [("commanded" if comp is None or not np.any(comp) else "commanded (compensation undone)", P[k],
+                WORKSPACE_TOL_MM)]
         if meas.target is not None:
             pts.append((target_what, meas.target[k], 1e-6))
         for what, p, tol in pts:
-            if not ws.contains(p, tol)[0]:
+            if not contains(p[None], tol)[0]:
                 raise DataFileError(
                     f"{what} pose {fmt_user_pose(robot, p, '.3f')} is outside the workspace {ws.describe()} "
                     f"(tolerance {tol:g} mm)", where=meas.where(k))
@@ -196,3 +257,5 @@ def check_against_robot(meas: Measurements, robot) -> None:
                     f"the commanded {units.joint_noun(robot)} reach {fmt_user_pose(robot, P[k], '.3f')}, {dist:.1f} mm "
                     f"from the target {fmt_user_pose(robot, meas.target[k])} (more than {TARGET_TOL_MM:g} mm: "
                     f"columns swapped, or {units.joint_noun(robot).split()[1]} not in {robot.mechanism.joint_user_unit}?)", where=meas.where(k))
+    if region is not None:
+        check_region_poses(robot, P if meas.target is None else meas.target, region, meas.where)

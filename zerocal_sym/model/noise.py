@@ -261,14 +261,27 @@ class VirtualPlant:
 
 
 def geometry_error(robot, err) -> np.ndarray:
-    """The geometry and measuring part of the source errors on the geometry vector, shape (G,).
+    """The geometry and measuring part of the source errors on the geometry vector, shape (G,) (or (N, G) for
+    ``err`` of shape (N, q)).
 
     A measuring-mechanism error is carried on its target, an entry of the base
     point ``c`` or of the platform point ``d``.
     """
     names = robot.mechanism.geometry_names
-    dg = np.zeros(len(names))
-    for e, v in zip(robot.errors, robot.errors.check_vector(err)):
-        if e.role != "zero_offset":
-            dg[names.index(e.target)] += v
+    errors = robot.errors
+    key = (id(errors), tuple(names))
+    hit = _TARGETS.get(key)
+    if hit is None or hit[0] is not errors:  # which errors add to which geometry entry: once per mechanism
+        sel = [k for k, e in enumerate(errors) if e.role != "zero_offset"]
+        hit = _TARGETS[key] = (errors, np.array(sel, int), np.array([names.index(errors.items[k].target)
+                                                                      for k in sel], int))
+    _, sel, tgt = hit
+    v = errors.check_vector(err)
+    dg = np.zeros(v.shape[:-1] + (len(names),))
+    for s_, t_ in zip(sel.tolist(), tgt.tolist()):  # in the errors' order, one after the other
+        dg[..., t_] += v[..., s_]
     return dg
+
+
+#: geometry_error's index maps per (source errors, geometry names)
+_TARGETS: dict = {}

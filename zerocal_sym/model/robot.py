@@ -447,6 +447,16 @@ def _deepest_line(text: str):
     return where if best else None
 
 
+def module_file(path) -> Path | None:
+    """The ``.py`` file a robot file's ``mechanism_module`` names (an input of every command that reads the robot
+    file), or None (no such line, a module name, or a file that does not parse: its loader says why)."""
+    try:
+        module = read_toml(path, RobotFileError, "robot file").get("mechanism_module")
+    except (RobotFileError, OSError, ValueError):
+        return None
+    return (Path(path).parent / module) if isinstance(module, str) and module.endswith(".py") else None
+
+
 def _register_module(keys: dict, path: Path, where) -> None:
     """Register the robot file's ``mechanism_module`` (a ``.py`` file relative to the file, or a module name)."""
     module = keys.get("mechanism_module")

@@ -107,6 +107,7 @@ class SourceErrors:
         self.extra_sets = dict(extra_sets or {})
         self.extra_sets.setdefault("default", tuple(e.name for e in self.items if e.role in ("zero_offset", "measuring")))
         self._resolved = {}   # resolve(spec) by spec: the sets and names do not change after construction
+        self._roles = {}      # of_role(role) by role, likewise
 
     def __len__(self) -> int:
         return len(self.items)
@@ -120,7 +121,10 @@ class SourceErrors:
     # -------------------------------------------------------------- by role
     def of_role(self, role: str) -> tuple:
         """Names with this role, in vector order."""
-        return tuple(e.name for e in self.items if e.role == role)
+        hit = self._roles.get(role)
+        if hit is None:
+            hit = self._roles[role] = tuple(e.name for e in self.items if e.role == role)
+        return hit
 
     @property
     def zero_offsets(self) -> tuple:

@@ -1,0 +1,200 @@
+"""Rounds of several calibration loops identified at once: the mapped Gauss-Newton, each round as ``identify_nlls``.
+
+:func:`identify_rounds` takes one measurement round per loop (each its own commanded joints, after its own
+compensation, and its own prior: the loop's current totals, for a sequential MAP the previous round's
+covariance) and runs the Gauss-Newton blocks of all of them in one mapped call per block
+(:meth:`~zerocal_sym.identify.nlls_problem.NllsProblem.run_batch`: every column evaluated as the single
+Function evaluates it).  A round whose Gauss-Newton converged and passes Ipopt's own first-order test
+(:func:`~zerocal_sym.identify.nlls_solve.ipopt_accepts`, as ``identify_nlls`` confirms it) gets the
+estimate, covariance and verdict ``identify_nlls`` would give, from the same functions on the same arrays
+(:func:`~zerocal_sym.identify.nlls_solve.information`, the fit check's chi² test
+:func:`~zerocal_sym.identify.fitstats.chi2_test`): the same numbers, bit for bit.  Every other round goes
+through :func:`~zerocal_sym.identify.nlls.identify_nlls` itself.
+
+What a loop reads of a round (``lean`` results): ``success``, ``status``, the estimate and covariance,
+``info["fit"]["rejected"]``; the fit check's per-reading statistics and the diagnosis of a rejected fit are
+not computed (``info["lean"]`` is True): ``zerocal compare`` does not report them.  Shapes: K poses, m
+joints, q source errors, p estimated parameters.
+"""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from zerocal_sym.errors import IdentificationError, ZerocalError
+from zerocal_sym.identify import fisher
+from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, RANK_RTOL, _Linear, chi2_test
+from zerocal_sym.identify.nlls_inputs import prior_whitener
+from zerocal_sym.identify.nlls_problem import EXPAND_MAX_K, GN_BLOCKS, get_problem
+from zerocal_sym.identify.nlls_solve import GN_STEP_TOL, information, ipopt_accepts, status_line
+from zerocal_sym.identify.result import IdentificationResult
+
+
+def _blocks(prob, z, P):
+    """Gauss-Newton blocks over the columns of ``z`` (p, n) and ``P`` (npar, n), each data set until its last step
+    is below the tolerance, as :meth:`NllsProblem.run_gauss_newton` does one.  Returns per data set the outputs
+    of its last block: ``z`` (p,), ``step``, ``r`` (K-1,), ``rp`` (p,), ``J`` (K-1 + p, p), ``pred`` (K-1,), ``l``
+    (K-1,), ``b`` (K-2,)."""
+    p, n = z.shape
+    last = [None] * n
+    todo = np.arange(n)
+    zc = z.copy()
+    for _ in range(GN_BLOCKS):
+        zk, sk, rk, rpk, Jk, pk, lk, bk = prob.run_batch(zc[:, todo], P[:, todo])
+        nxt = []
+        for j, i in enumerate(todo.tolist()):
+            zi = np.array(zk[:, j])
+            last[i] = (zi, float(sk[0, j]), np.array(rk[:, j]), np.array(rpk[:, j]),
+                       np.array(Jk[:, j * p:(j + 1) * p], order="F"), np.array(pk[:, j]), np.array(lk[:, j]),
+                       np.array(bk[:, j]))
+            zc[:, i] = zi
+            if np.isfinite(zi).all() and not sk[0, j] < GN_STEP_TOL:
+                nxt.append(i)
+        todo = np.array(nxt, int)
+        if not todo.size:
+            break
+    return last
+
+
+class _Verdict:
+    """What :func:`~zerocal_sym.identify.fitstats.chi2_test` reads of a :class:`_Linear` without prior rows, from
+    the SVD ``svd`` of the Jacobian already computed: ``r``, ``valid``, ``dof`` (the same definitions)."""
+
+    def __init__(self, r, Jd, l, b, svd):
+        self.r = r
+        self.valid = bool(np.isfinite(r).all() and np.isfinite(Jd).all() and np.isfinite(l).all()
+                          and np.isfinite(b).all() and np.all(l != 0))
+        if self.valid:
+            s = svd[1]
+            rank = int(np.count_nonzero(s > RANK_RTOL * (s[0] if s.size else 0.0))) if s.size else 0
+        else:  # (_Linear zeroes what is not finite and takes its own SVD; the verdict is "rejected" either way)
+            rank = 0
+        self.dof = r.size - rank
+
+
+def _lean(robot, names, scale, noise, prior_q, w, sol, K, alpha) -> IdentificationResult:
+    """The result ``identify_nlls`` gives for a confirmed point ``sol``: its estimate, covariance and verdict (the
+    fit check's chi² test; the per-reading statistics and a rejection's diagnosis left out)."""
+    errors = robot.errors
+    r, rp, J, l, b = sol.r, sol.rp, sol.J, sol.l, sol.b
+    has_prior = bool(w.any())
+    Jd = J[: K - 1]
+    svd, sv, rank, cov, nonid, offsets_ok = information(J, Jd, r, K, has_prior, noise, scale, names, errors)
+    success = sol.converged and offsets_ok and svd is not None
+    status = status_line(sol, offsets_ok, rank, names, None, "l2")
+    rows = np.flatnonzero(np.any(w != 0, axis=1)) if has_prior else ()
+    if len(rows):  # the fit check's whitened problem with the prior rows (its own SVD)
+        lin = _Linear(np.concatenate([r, rp[rows]]), np.vstack([Jd, J[K - 1:][rows]]), (l, b), np.arange(1, K),
+                      np.zeros(K - 1), np.eye(len(names)), scale, names, len(rows))
+    else:  # the same quantities from J's SVD (as _Linear takes it: the data rows are all of J's information)
+        lin = _Verdict(r, Jd, l, b, svd)
+    chi2, dof, checked, rejected, p, _ = chi2_test(lin, noise, alpha)
+    if rejected and success:
+        success = False
+        status = "rejected: the noise model rejects the fit" + (f" (chi2 {chi2:.4g} on {dof} dof, p = {p:.3g})"
+                                                               if np.isfinite(chi2) else "")
+    info = {"solver_status": sol.ret, "iterations": sol.iterations, "chi2": float(r @ r), "rank": rank,
+            "confirmation": sol.confirmation, "prior": prior_q.tolist(), "nonidentifiable": nonid,
+            "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
+            "fit": {"checked": checked, "rejected": rejected, "chi2": chi2, "dof": dof, "p_value": p, "alpha": alpha},
+            "lean": True}
+    return IdentificationResult(method="nlls", params=names, estimate=sol.z / scale, covariance=cov,
+                                success=bool(success), status=status, info=info, errors=errors,
+                                std_kind="from residuals" if noise.is_zero else "total")
+
+
+def identify_rounds(robot, rounds, priors, params, noise, prior_covs=None, alpha: float = DEFAULT_ALPHA) -> list:
+    """Identify one round per loop at once, each as ``identify_nlls(robot, round, params, noise, prior=prior,
+    prior_cov=prior_cov)`` (the defaults otherwise) would.
+
+    Parameters
+    ----------
+    rounds : list of Measurements
+        ``theta_cmd`` (K, m) and ``readings`` (K,) each; the same K.
+    priors : list of ndarray, shape (q,)
+        The source errors each round is identified from (its loop's totals).
+    params : tuple of str
+        The parameters estimated (resolved names).
+    noise : NoiseModel
+    prior_covs : list of ndarray (p, p) or None, optional
+        A Gaussian prior per round (a sequential MAP), None where there is none.
+
+    Returns
+    -------
+    list
+        Per round its :class:`IdentificationResult` (lean when confirmed in the batch, see the module), or the
+        :class:`IdentificationError` / :class:`ZerocalError` ``identify_nlls`` raised for it.
+    """
+    from zerocal_sym.identify.nlls import identify_nlls, noise_terms
+
+    n = len(rounds)
+    prior_covs = [None] * n if prior_covs is None else list(prior_covs)
+    out = [None] * n
+
+    def single(i):
+        try:
+            out[i] = identify_nlls(robot, rounds[i], params, noise=noise, prior=priors[i], prior_cov=prior_covs[i],
+                                   fit_alpha=alpha)
+        except (IdentificationError, ZerocalError) as exc:
+            out[i] = exc
+
+    K = np.shape(rounds[0].theta_cmd)[0] if n else 0
+    ok = [i for i in range(n) if np.shape(rounds[i].theta_cmd)[0] == K
+          and np.isfinite(rounds[i].theta_cmd).all() and np.isfinite(rounds[i].readings).all()]
+    if K > EXPAND_MAX_K or K - 1 < 1:  # identify_nlls' numpy problem above EXPAND_MAX_K poses: no mapped twin
+        ok = []
+    batch = set(ok)
+    for i in range(n):
+        if i not in batch:
+            single(i)
+    if not ok:
+        return out
+    errors = robot.errors
+    names = tuple(params)
+    scale = fisher.parameter_scale(robot, names)
+    prob = get_problem(robot, K, names)
+    prob.hot()
+    sm2, sx2 = noise_terms(noise)
+    geometry = robot.geometry
+    ws, mus, cols = {}, {}, []
+    for i in ok:
+        prior_q = np.asarray(priors[i], float)
+        ws[i] = prior_whitener(names, None, prior_covs[i])
+        mus[i] = errors.take(prior_q, names)
+        meas = rounds[i]
+        cols.append(prob.pack(meas.theta_cmd, geometry, prior_q, np.asarray(meas.readings, float)[1:], scale,
+                              mus[i], ws[i], sm2, sx2))
+    P = np.array(cols).T
+    Z0 = np.array([mus[i] * scale for i in ok]).T
+    last = _blocks(prob, Z0, P)
+    for j, i in enumerate(ok):
+        z, step, r, rp, J, pred, l, b = last[j]
+        if not (np.isfinite(z).all() and step < GN_STEP_TOL and ipopt_accepts(J, r, rp, K)):
+            single(i)  # Ipopt decides, as in identify_nlls
+            continue
+        sol = SimpleNamespace(z=z, ret="Solve_Succeeded", converged=True, iterations=0, gn_ok=True, step=step,
+                              l=l, b=b, r=r, rp=rp, J=J, pred=pred, confirmation="first-order test")
+        out[i] = _lean(robot, names, scale, noise, np.asarray(priors[i], float), ws[i], sol, K, alpha)
+    return out
+
+
+class LoopRounds:
+    """``identify_many`` of :func:`~zerocal_sym.identify.loop.calibration_loops` (``pass_loops=True``) for Ipopt
+    loops: each round as ``make_nlls_identifier(params, noise, sequential)``'s identifier of its loop would
+    identify it (the sequential MAP's prior from that loop's previous result), all of them at once
+    (:func:`identify_rounds`)."""
+
+    def __init__(self, names, noise, sequential: bool):
+        self.names, self.noise, self.sequential = names, noise, sequential
+        self.last = {}
+
+    def __call__(self, robot, rounds, priors, loops):
+        from zerocal_sym.identify.nlls import sequential_prior_cov
+
+        covs = [sequential_prior_cov(robot, self.names, self.last.get(i), pr) if self.sequential else None
+                for i, pr in zip(loops, priors)]
+        out = identify_rounds(robot, rounds, priors, self.names, self.noise, covs)
+        for i, res in zip(loops, out):
+            self.last[i] = None if isinstance(res, BaseException) else res
+        return out
