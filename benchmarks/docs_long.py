@@ -5,7 +5,7 @@ A few figures come from Monte Carlo runs of minutes (many groups, hundreds of tr
 quotes them from this script's output, with its date and load, and says so.  Each run below prints the command,
 then its output (whole, or the summary a page quotes), then its CPU and wall time.
 
-Usage: python benchmarks/docs_long.py [NAME ...]      (NAME: reproduce, rules, compare, arms; default all)
+Usage: python benchmarks/docs_long.py [NAME ...]      (NAME: reproduce, rules, compare, arms, hexapod; default all)
 
 * reproduce (README.md's results, docs/reproduction.md "What reproduces" and "What does not reproduce"):
   ``zerocal reproduce --trials 100`` with the scale error alone and with the paper's noise; per quantity the range
@@ -17,6 +17,8 @@ Usage: python benchmarks/docs_long.py [NAME ...]      (NAME: reproduce, rules, c
   error alone; whole output.
 * arms (docs/trust.md, "Why the design measure"): ``python examples/delta_arms.py``, the exact path's design for
   the Delta's offsets and arms against the design measure's; whole output.  Run from the repository's root.
+* hexapod (docs/design.md, "Results: the linear Delta and the hexapod"): the hexapod's K = 64 crlb design with
+  the tolerances of a machined robot (``--tolerance-scale 0.04``); whole output.
 """
 import argparse
 import datetime
@@ -69,6 +71,8 @@ RUNS = {
                                         "zerocal compare --trials 500 --group 1 --frame literal",
                                         "zerocal compare --trials 500 --group 1 --noise scale-only")],
     "arms": [("python examples/delta_arms.py", None)],
+    "hexapod": [("zerocal design --robot examples/hexapod.toml --optimize --K 64 --criterion crlb --tolerance-scale 0.04",
+                 None)],
 }
 
 
