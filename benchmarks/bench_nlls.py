@@ -76,7 +76,7 @@ def main():
 
     from scipy.optimize import least_squares
 
-    from zerocal_sym.identify import nlls_problem
+    from zerocal_sym.identify.estimate import nlls_problem
     from zerocal_sym.identify.batch import identify_batch
     from zerocal_sym.model import compiled
     from zerocal_sym.identify.nlls import identify_nlls, residual_problem

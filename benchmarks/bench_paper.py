@@ -37,7 +37,7 @@ def main():
     from zerocal_sym.model.robot import paper_robot
     from zerocal_sym.paper.scheme import paper_poses
     from zerocal_sym.identify.linear import identification_matrix
-    from zerocal_sym.identify.truncated_svd import tsvd_solve
+    from zerocal_sym.identify.estimate.truncated_svd import tsvd_solve
     from zerocal_sym.identify.tsvd import identify_tsvd
 
     load0 = load()

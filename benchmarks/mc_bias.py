@@ -33,7 +33,8 @@ import time
 import numpy as np
 
 from zerocal_sym import design
-from zerocal_sym.identify import bias, fisher
+from zerocal_sym.identify.budget import bias
+from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.noise import NoiseModel
 from zerocal_sym.model.robot import paper_robot

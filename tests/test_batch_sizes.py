@@ -20,7 +20,7 @@ def test_vectorised_p_values_are_the_scalar_ones_bit_for_bit():
 def test_batch_functions_per_power_of_two_give_each_column_alone():
     """N data sets through the Function mapped over the next power of two (padded): each column the same bits as
     that data set alone, and one Function serves every N up to its size."""
-    from zerocal_sym.identify import nlls_problem
+    from zerocal_sym.identify.estimate import nlls_problem
     from zerocal_sym.identify.batch import identify_batch
     from zerocal_sym.model import kinematics as kin
     from zerocal_sym.model.noise import NoiseModel, VirtualPlant

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from zerocal_sym.cli import main
-from zerocal_sym.identify import bias, bias_exact
+from zerocal_sym.identify.budget import bias, bias_exact
 from zerocal_sym.identify.batch import identify_batch
 from zerocal_sym.identify.tsvd import identify_tsvd, identify_tsvd_many
 from zerocal_sym.model import kinematics as kin

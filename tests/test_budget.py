@@ -83,7 +83,7 @@ def test_the_paper_robot_keeps_table_2_set_a():
 def test_budget_is_the_bias_bound_split_by_entry(capsys, tmp_path):
     """robot_file_bias is the first-order worst case of identify's bias report; its dominant entries are the three
     largest |S_ij| t_j; limited_by follows it against the 1 sigma; the results reader applies the same rule."""
-    from zerocal_sym.identify.budget import limited_by
+    from zerocal_sym.identify.budget.error_budget import limited_by
 
     data = simulate(capsys, tmp_path / "d.csv", EX / "delta.toml", "--set", "theta1=1", "--set", "theta2=-0.5",
                     "--noise", "scale-only")

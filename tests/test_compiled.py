@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from zerocal_sym.errors import ZerocalError
-from zerocal_sym.identify import nlls_problem
+from zerocal_sym.identify.estimate import nlls_problem
 from zerocal_sym.identify.batch import identify_batch
-from zerocal_sym.identify.nlls import identify_nlls, noise_terms
+from zerocal_sym.identify.nlls import identify_nlls
+from zerocal_sym.identify.estimate.nlls_solve import noise_terms
 from zerocal_sym.identify.fisher import parameter_scale
 from zerocal_sym.model import compiled
 from zerocal_sym.model import kinematics as kin
@@ -188,7 +189,7 @@ def _start_build_and_exit(cache, stop):
     import sys
 
     code = ("from zerocal_sym.model.robot import paper_robot\n"
-            "from zerocal_sym.identify.nlls_problem import get_problem\n"
+            "from zerocal_sym.identify.estimate.nlls_problem import get_problem\n"
             "import time\nfrom zerocal_sym.model import compiled\n"
             "p = get_problem(paper_robot(), 6, 'paper')\n"
             "p.hot()\nt0 = time.time()\n"

@@ -14,7 +14,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import compare_cases  # noqa: E402
 import confirmation_cases as cc  # noqa: E402
 
-from zerocal_sym.identify import nlls_solve  # noqa: E402
+from zerocal_sym.identify.estimate import nlls_solve  # noqa: E402
 
 REFERENCE = json.loads(cc.REFERENCE.read_text())
 #: the library versions that wrote the reference: there, every number is the same bit for bit
@@ -100,7 +100,7 @@ def test_the_test_is_ipopts_own():
     """At a converged point the test passes with a wide margin (the gradient far below Ipopt's tolerance) and
     Ipopt, asked, stops there after 0 iterations; a point one step short of convergence fails it, and Ipopt
     iterates."""
-    from zerocal_sym.identify import nlls_problem
+    from zerocal_sym.identify.estimate import nlls_problem
     from zerocal_sym.identify.nlls import identify_nlls
 
     case = _case("planar-default")
@@ -113,7 +113,7 @@ def test_the_test_is_ipopts_own():
     K = meas.theta_cmd.shape[0]
     prob = nlls_problem.get_problem(robot, K, "paper")
     from zerocal_sym.identify import fisher
-    from zerocal_sym.identify.nlls import noise_terms
+    from zerocal_sym.identify.estimate.nlls_solve import noise_terms
 
     names = robot.errors.resolve("paper")
     scale = fisher.parameter_scale(robot, names)

@@ -14,7 +14,8 @@ from zerocal_sym import design
 from zerocal_sym.cli import main
 from zerocal_sym.design import DesignError, approx, criteria, fewest, measure, posemodel, rounding
 from zerocal_sym.design import nlp as design_nlp
-from zerocal_sym.identify import bias, fisher
+from zerocal_sym.identify.budget import bias
+from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.design.terms import Weights
 from zerocal_sym.model.noise import NoiseModel

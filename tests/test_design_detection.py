@@ -15,7 +15,7 @@ from zerocal_sym import design
 from zerocal_sym.cli import main
 from zerocal_sym.design import power as pw
 from zerocal_sym.design.detection import Requirement, detection
-from zerocal_sym.identify.exact_refits import _Exact
+from zerocal_sym.identify.estimate.exact_model import _Exact
 from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements

@@ -10,7 +10,9 @@ import pytest
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.batch import identify_batch
 from zerocal_sym.identify.chi2 import chi2_cdf, chi2_sf
-from zerocal_sym.identify.fitcheck import deletion_diagnostics, fit_check, plausibility
+from zerocal_sym.identify.diagnose.deletions import deletion_diagnostics
+from zerocal_sym.identify.fitcheck import fit_check
+from zerocal_sym.identify.check.plausibility import plausibility
 from zerocal_sym.identify.loop import calibration_loop
 from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.identify.result import IdentificationResult
@@ -442,7 +444,7 @@ def test_detection_rate_of_one_bad_reading(robot):
 
 def test_banded_per_reading_terms_equal_the_dense_ones(case):
     """identify_nlls's per-reading statistics come from the O(K p) banded terms of its CasADi functions
-    (nlls_problem._fit_terms); the fit check recomputed by fit_check (fitstats' bidiagonal solves in numpy)
+    (nlls_problem._fit_terms); the fit check recomputed by fit_check (whitened's bidiagonal solves in numpy)
     gives the same numbers, a bad reading included."""
     for th, bad in ((case.th_large, None), (case.th_large, (3, 0.05)), (case.th_small, None)):
         m = case.meas(th, seed=5, bad=bad)

@@ -22,13 +22,15 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference_cases as rc  # noqa: E402
 
-from zerocal_sym.identify import fisher, leave_out, robust  # noqa: E402
+from zerocal_sym.identify import fisher  # noqa: E402
+from zerocal_sym.identify.diagnose import leave_out  # noqa: E402
+from zerocal_sym.identify.estimate import robust  # noqa: E402
 from zerocal_sym.identify.chi2 import chi2_sf  # noqa: E402
-from zerocal_sym.identify.fitcheck import deletion_diagnostics  # noqa: E402
-from zerocal_sym.identify.fitstats import DEFAULT_ALPHA  # noqa: E402
+from zerocal_sym.identify.diagnose.deletions import deletion_diagnostics  # noqa: E402
+from zerocal_sym.identify.check.statistics import DEFAULT_ALPHA  # noqa: E402
 from zerocal_sym.identify.nlls import identify_nlls  # noqa: E402
-from zerocal_sym.identify.nlls_problem import EXPAND_MAX_K  # noqa: E402
-from zerocal_sym.identify.nlls_solve import GN_STEP_TOL  # noqa: E402
+from zerocal_sym.identify.estimate.nlls_problem import EXPAND_MAX_K  # noqa: E402
+from zerocal_sym.identify.estimate.nlls_solve import GN_STEP_TOL  # noqa: E402
 from zerocal_sym.identify.tsvd import identify_tsvd  # noqa: E402
 from zerocal_sym.model.noise import NoiseModel  # noqa: E402
 

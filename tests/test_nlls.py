@@ -222,7 +222,7 @@ def test_large_k_graph_gives_the_same_answer(robot, monkeypatch):
     """Above EXPAND_MAX_K a round is identified in numpy with the banded whitening (nlls_banded: Gauss-Newton,
     Ipopt on callbacks) and the Monte Carlo's batches use an MX graph (mapped model, mapaccum recurrences):
     same answer."""
-    from zerocal_sym.identify import nlls_problem
+    from zerocal_sym.identify.estimate import nlls_problem
 
     th = kin.ik(robot, paper_poses(robot, 5))
     noise = NoiseModel.paper()

@@ -11,7 +11,7 @@ from zerocal_sym.design import approx, rounding
 from zerocal_sym.identify import fisher
 from zerocal_sym.identify.covariance import ChangeCovariance
 from zerocal_sym.identify.nlls import identify_nlls
-from zerocal_sym.identify.revisits import reml_revisit_std
+from zerocal_sym.identify.estimate.revisits import reml_revisit_std
 from zerocal_sym.identify.tsvd import identify_tsvd
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
@@ -136,7 +136,7 @@ def test_nlls_and_tsvd_weight_by_the_full_covariance(robot):
 def test_restricted_likelihood_is_the_dense_one(monkeypatch):
     """Both forms of the REML likelihood (every pose low-rank, bands fixed; or bands per sigma_r) against the
     dense formula."""
-    from zerocal_sym.identify import revisits
+    from zerocal_sym.identify.estimate import revisits
 
     rng = np.random.default_rng(2)
     lab = np.array([0, 1, 2, 0, 3, 1, 4, 2, 5, 0, 6, 3, 7, 1])

@@ -9,7 +9,7 @@ from zerocal_sym.identify.fisher import crlb_zero_offsets_deg
 from zerocal_sym.model.noise import NoiseModel, VirtualPlant
 from zerocal_sym.identify.loop import simulate_round
 from zerocal_sym.paper.scheme import paper_poses
-from zerocal_sym.identify.truncated_svd import tsvd_solve
+from zerocal_sym.identify.estimate.truncated_svd import tsvd_solve
 from zerocal_sym.identify.tsvd import identify_tsvd
 from roundoff import cond_tol
 

@@ -137,7 +137,7 @@ def check_round_poses(robot, P, theta_cmd, source: str, allow_revisits: bool = F
 
     from zerocal_sym.errors import PoseError
     from zerocal_sym.identify.linear import identification_matrix
-    from zerocal_sym.identify.tsvd import COLLINEAR_RTOL, RANK_RTOL
+    from zerocal_sym.identify.estimate.tsvd_round import COLLINEAR_RTOL, RANK_RTOL
     from zerocal_sym.io.duplicates import first_duplicate
     from zerocal_sym.io.measurements import MIN_POSES
     from zerocal_sym.model import kinematics as kin

@@ -168,7 +168,7 @@ def constraints_from_args(robot, args):
 def tolerances_from_args(robot, args):
     """Tolerances of the omitted errors (internal units) from ``--tolerance``, ``--tolerance-file``, ``--tolerance-scale``."""
     from zerocal_sym.design.terms import design_params
-    from zerocal_sym.identify.bias import make_tolerances
+    from zerocal_sym.identify.budget.bias import make_tolerances
 
     return make_tolerances(robot, getattr(args, "tolerance", None) or [], getattr(args, "tolerance_file", None),
                            getattr(args, "tolerance_scale", 1.0), params=design_params(robot),

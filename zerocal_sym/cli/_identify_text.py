@@ -69,7 +69,7 @@ def print_estimate(robot, res) -> None:
 
 def verdict_line(res, args, remedy=None, K=None) -> str:
     """The one line a person acts on: accepted / why, the offsets' 1 sigma, what limits them (``remedy``:
-    :func:`zerocal_sym.identify.budget.remedy`) and how to lower it, the next command."""
+    :func:`zerocal_sym.identify.budget.error_budget.remedy`) and how to lower it, the next command."""
     why = accepted_why(res.info.get("fit") or {}, args.fit_alpha)
     robot = ["--robot", args.robot] if getattr(args, "robot", None) else []
     compensate = _command("compensate", args.out or "RESULT.json", *robot, "--out", "table.csv")
@@ -99,7 +99,7 @@ def accepted_why(fit: dict, alpha: float) -> str:
 
 def limit_text(remedy: dict, args, K=None) -> str:
     """What limits the offsets and how to lower it (a clause of the verdict line)."""
-    from zerocal_sym.identify.budget import compact_names
+    from zerocal_sym.identify.budget.error_budget import compact_names
 
     if remedy["limited_by"] == "data":
         return remedy["text"]
@@ -151,7 +151,7 @@ def repeat_options(args) -> list:
 
 def print_budget(out: dict) -> None:
     """The error budget of the offsets (``out["error_budget"]``) and what limits them, as text."""
-    from zerocal_sym.identify.budget import format_budget
+    from zerocal_sym.identify.budget.error_budget import format_budget
 
     budget = out.get("error_budget")
     if not budget:
@@ -175,7 +175,7 @@ def print_choice(choice: dict) -> None:
 
 def print_group_test(test: dict) -> None:
     """The likelihood-ratio test of each group of robot-file entries, as text."""
-    from zerocal_sym.identify.fitstats import _fmt_p
+    from zerocal_sym.identify.chi2 import _fmt_p
 
     print(f"robot-file test (each group of entries held at the file's values freed in turn; alpha {test['alpha']:g}):")
     for r in test["groups"]:

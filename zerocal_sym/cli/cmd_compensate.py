@@ -117,7 +117,7 @@ def run(args):
         raise ZerocalError("--n is the number of poses per boundary of --scheme")
     if args.result is not None:
         from zerocal_sym.cli.cmd_identify import max_offset_arg
-        from zerocal_sym.identify.fitcheck import plausibility
+        from zerocal_sym.identify.check.plausibility import plausibility
 
         res = load_result(args.result, allow_failed=True, robot=robot)
         check_result_robot(res, robot, args.result)

@@ -15,7 +15,7 @@ solver status, the identifiability of the parameters from these poses, the
 error budget of the offsets (their 1 sigma from the data against the bias the
 robot-file entries held at their values can put on them within their
 ``[tolerances]``; ``error_budget`` and ``limited_by`` in the JSON:
-:mod:`zerocal_sym.identify.budget`, docs/trust.md), and
+:mod:`zerocal_sym.identify.budget.error_budget`, docs/trust.md), and
 the compensation (sign convention: ``theta_cmd = IK(P) - offset``; the actual
 joint angle is the commanded one plus the offset).  ``--json`` prints the
 results JSON that ``zerocal compensate`` reads; ``--out`` writes it
@@ -251,7 +251,7 @@ def run(args):
         raise ZerocalError(f"--loss {args.loss}: a robust loss does not take the robot file's shared revisit error "
                            f"([noise] revisit_std_mm = {noise.sigma_revisit_mm:g}): use --loss l2, or --noise "
                            "scale-only / servo-only")
-    from zerocal_sym.identify.bias import make_tolerances
+    from zerocal_sym.identify.budget.bias import make_tolerances
 
     auto = args.params == "auto"
     try:  # the tolerances of the errors left out, checked before any work
@@ -284,7 +284,7 @@ def run(args):
         if args.truncation is not None or args.rule is not None or args.iterate is not None:
             raise ZerocalError("--truncation, --rule and --iterate are for --method tsvd")
         if auto:  # the set whose offsets' expected error at these poses is least
-            from zerocal_sym.identify.choose import choose_params
+            from zerocal_sym.identify.budget.choose import choose_params
 
             choice = choose_params(robot, meas.theta_cmd, tol, noise if not noise.is_zero else None, "paper", prior)
             names = errors.resolve(choice["chosen"])
@@ -352,7 +352,7 @@ def run(args):
             print(f"verdict: rejected: {status}{said}; next: see the diagnosis above, fix the data or the robot file "
                   "and identify again")
         return 1
-    from zerocal_sym.identify.fitcheck import plausibility
+    from zerocal_sym.identify.check.plausibility import plausibility
 
     reasons = plausibility(robot, res, max_offset=max_offset_arg(args, robot), max_maemm_mm=args.max_maemm_mm)
     if reasons:
@@ -392,7 +392,7 @@ def run(args):
         print(f"Ipopt: {info['solver_status']}, {info['iterations']} iterations, cost {info['cost']:.6g}, "
               f"chi2 {info['chi2']:.4g} on {info['dof']} dof; weights: {info['weighting']}")
     if "revisits" in info:
-        from zerocal_sym.identify.revisits import describe
+        from zerocal_sym.identify.estimate.revisits import describe
 
         print(describe(info["revisits"]))
     if args.report:
@@ -407,11 +407,11 @@ def _bias_report(robot, meas, res, tol, names, noise, err0, prior, args) -> dict
     """The bias the omitted errors' tolerances may put on this method's estimate: TSVD's own operator (at its last
     step's linearisation point, its truncation) or the weighted fit's sensitivity, linearised at the estimate
     (TSVD's less its linearisation bias), each offset's worst case searched on the exact model
-    (:mod:`zerocal_sym.identify.bias_exact`)."""
+    (:mod:`zerocal_sym.identify.budget.bias_exact`)."""
     import numpy as np
 
-    from zerocal_sym.identify import bias_exact
-    from zerocal_sym.identify.bias import tsvd_bias_operator
+    from zerocal_sym.identify.budget import bias_exact
+    from zerocal_sym.identify.budget.bias import tsvd_bias_operator
 
     errors = robot.errors
     if res.method == "tsvd":
@@ -432,7 +432,7 @@ def _bias_report(robot, meas, res, tol, names, noise, err0, prior, args) -> dict
 def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, tol) -> dict:
     """The results JSON's ``error_budget``, ``limited_by``, ``remedy``, and ``params_choice`` (``--params auto``)
     and ``robot_file_test`` (``--test-groups``, or an nlls fit rejected without a detected cause)."""
-    from zerocal_sym.identify import budget as bg
+    from zerocal_sym.identify.budget import error_budget as bg
 
     b = bg.error_budget(bias, res)
     spec = choice["chosen"] if choice else ("paper" if res.method == "tsvd" else args.params)
@@ -445,12 +445,14 @@ def budget_entries(robot, res, bias, names, choice, args, meas, noise, prior, to
                                                                             fit.get("causes", []))
                    and (args.loss in (None, "l2")) and not args.bound and not args.prior_std)
     if getattr(args, "test_groups", False) or unexplained:
-        from zerocal_sym.identify.freeing import free_each_group
+        from zerocal_sym.identify.budget.freeing import free_each_group
+        from zerocal_sym.identify.nlls import identify_nlls
 
         out["robot_file_test"] = free_each_group(robot, meas, spec, noise=noise, prior=prior, alpha=args.fit_alpha,
                                                  tolerances=tol,
                                                  held=res if res.method == "nlls" and not args.bound
-                                                 and not args.prior_std and args.loss in (None, "l2") else None)
+                                                 and not args.prior_std and args.loss in (None, "l2") else None,
+                                                 identify=identify_nlls)
     from zerocal_sym.io.files import json_safe
 
     return json_safe(out)

@@ -46,7 +46,8 @@ def verdict(robot, rf, goal=None, max_offset=None) -> tuple:
     from types import SimpleNamespace
 
     from zerocal_sym.cli._identify_text import accepted_why, offsets_sigma_text
-    from zerocal_sym.identify.fitcheck import DEFAULT_ALPHA, plausibility
+    from zerocal_sym.identify.fitcheck import DEFAULT_ALPHA
+    from zerocal_sym.identify.check.plausibility import plausibility
 
     from zerocal_sym.report.contents import fit_record
 

@@ -121,7 +121,7 @@ def run(args):
     applied = load_result(args.result, robot=robot)
     check_result_robot(applied, robot, args.result)
     from zerocal_sym.cli.cmd_identify import max_offset_arg
-    from zerocal_sym.identify.fitcheck import plausibility
+    from zerocal_sym.identify.check.plausibility import plausibility
 
     reasons = plausibility(robot, applied, max_offset=max_offset_arg(args, robot), max_maemm_mm=args.max_maemm_mm)
     if reasons:  # as compensate: not a calibration to verify (and not a prior for the re-identification)

@@ -313,7 +313,7 @@ def load_spec(path, allow_revisits: bool = False) -> Study:
     from zerocal_sym.cli._checks import MAX_N, identifiability_problem
     from zerocal_sym.identify.montecarlo import offsets_missing
     from zerocal_sym.cli._common import parse_named_values
-    from zerocal_sym.identify.fitcheck import DEFAULT_MAX_MAEMM_MM, DEFAULT_MAX_OFFSET_DEG
+    from zerocal_sym.identify.check.plausibility import DEFAULT_MAX_MAEMM_MM, DEFAULT_MAX_OFFSET_DEG
     from zerocal_sym.model import kinematics as kin
 
     from zerocal_sym.model.robot import read_toml

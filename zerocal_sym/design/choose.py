@@ -2,14 +2,14 @@
 
 ``zerocal design --optimize --choose-params``: for a parameter set ``S`` (the
 robot's identified set plus whole groups of the robot-file entries it holds,
-:func:`zerocal_sym.identify.choose.held_groups`) a K-pose design is made for
+:func:`zerocal_sym.identify.budget.choose.held_groups`) a K-pose design is made for
 ``S`` and scored by the offsets' expected error at its poses,
 ``sqrt(mean_i (CRLB_i(S)^2 + sum_{j held} S_ij^2 t_j^2 / 3))``
-(:func:`zerocal_sym.identify.choose.expected_error`: the variance of what is
+(:func:`zerocal_sym.identify.budget.choose.expected_error`: the variance of what is
 identified, the squared bias from the tolerances of what is held).  The sets
 are searched forward: from the robot's set, add the group whose design scores
 least, while that lowers the score by more than
-:data:`zerocal_sym.identify.choose.MARGIN`.  The designs of the search are
+:data:`zerocal_sym.identify.budget.choose.MARGIN`.  The designs of the search are
 approximate designs (the design measure rounded to K poses, about a second
 each; :func:`zerocal_sym.design.optimize.optimize_design` with
 ``method="approx"``); the chosen set's design is then made as asked.
@@ -44,7 +44,7 @@ def choose_design_params(robot, K: int, criterion: str, cons, noise, tolerances,
         no design was found; least first), ``search``, ``model``.
     """
     from zerocal_sym.design.optimize import optimize_design
-    from zerocal_sym.identify.choose import MARGIN, expected_error, held_groups, set_spec
+    from zerocal_sym.identify.budget.choose import MARGIN, expected_error, held_groups, set_spec
     from zerocal_sym.model import kinematics as kin
 
     base = robot.identified_set

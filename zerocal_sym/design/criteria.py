@@ -46,8 +46,8 @@ Criteria (all minimised internally as a log)
     ``sqrt(mean_i (CRLB_i^2 + E[b_i^2]))`` in the offsets' file unit (minimised): the RMS
     error of the m zero offsets including the first-order bias ``b`` from the
     source errors the model leaves out, each uniform within its tolerance
-    (:mod:`zerocal_sym.identify.bias`; ``E[b_i^2] = sum_j S_ij^2 t_j^2 / 3``);
-    with the ``worst`` bias model (:class:`zerocal_sym.identify.bias.Tolerances`)
+    (:mod:`zerocal_sym.identify.budget.bias`; ``E[b_i^2] = sum_j S_ij^2 t_j^2 / 3``);
+    with the ``worst`` bias model (:class:`zerocal_sym.identify.budget.bias.Tolerances`)
     the squared worst case ``(sum_j |S_ij| t_j)^2`` instead.  The bias does
     not shrink with K; the variance does.
 
@@ -270,7 +270,7 @@ def criterion_values(robot, P, noise: NoiseModel | None = None, tolerances=None)
         Poses in visiting order, mm.
     tolerances : dict name -> value (internal units), optional
         Tolerances of the omitted errors for ``mse`` (default
-        :func:`zerocal_sym.identify.bias.default_tolerances`).
+        :func:`zerocal_sym.identify.budget.bias.default_tolerances`).
 
     Returns
     -------
@@ -324,7 +324,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
         One of :data:`DESIGN_CRITERIA` (``checked``: the value is the crlb's).
     tolerances : dict name -> value (internal units), optional
         Tolerances of the omitted errors (``mse`` and the ``bias`` entry;
-        default :func:`zerocal_sym.identify.bias.default_tolerances`).
+        default :func:`zerocal_sym.identify.budget.bias.default_tolerances`).
     requirement : zerocal_sym.design.detection.Requirement, optional
         What the ``detection`` entry judges (default: its defaults with ``tolerances``).
 
@@ -339,7 +339,7 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
         ``values`` (all seven), ``units_all``}, ``crlb_zero_offsets_deg`` (m,)
         from :func:`zerocal_sym.identify.fisher.crlb_zero_offsets_user` and
         its RMS ``crlb_rms_deg``, ``bias`` (worst-case and RMS bias of the
-        zero offsets from the tolerances, :func:`zerocal_sym.identify.bias.tolerance_bias`,
+        zero offsets from the tolerances, :func:`zerocal_sym.identify.budget.bias.tolerance_bias`,
         and the RMS error ``sqrt(CRLB^2 + RMS bias^2)`` per offset),
         ``position`` (RMS and worst position error over the workspace grid
         after compensation, mm), ``kappa`` (the paper's kappa_1 of G, no
@@ -347,7 +347,8 @@ def evaluate(robot, P, criterion: str = "crlb", noise: NoiseModel | None = None,
         ``detection`` (what the fit check sees: :func:`zerocal_sym.design.detection.detection`) and, with
         ``cons``, ``violations``.
     """
-    from zerocal_sym.identify import bias, fisher
+    from zerocal_sym.identify.budget import bias
+    from zerocal_sym.identify import fisher
     from zerocal_sym.identify.linear import condition_number, identification_matrix
 
     P = np.atleast_2d(np.asarray(P, float))
@@ -399,7 +400,7 @@ def _detection(robot, P, noise, tolerances, requirement):
 def _bias_report(robot, theta, noise, tolerances, crlb):
     """The zero offsets' bias from the tolerances and the RMS error with the CRLB (the offsets' file unit:
     keys ``worst_case_deg`` ... for revolute joints, ``worst_case_mm`` ... for prismatic ones)."""
-    from zerocal_sym.identify import bias
+    from zerocal_sym.identify.budget import bias
 
     try:
         b = bias.tolerance_bias(robot, theta, tolerances, design_params(robot), noise)

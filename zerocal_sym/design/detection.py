@@ -69,7 +69,7 @@ class Requirement:
                  scale_error: float = pw.DEFAULT_SCALE_ERROR, entries: bool = False):
         from zerocal_sym.design.limits import DesignError
         from zerocal_sym.design.terms import design_params, omitted_params
-        from zerocal_sym.identify import bias
+        from zerocal_sym.identify.budget import bias
 
         checks = (("the fit check's level alpha", alpha, 0.0, 1.0), ("the power", target, 0.0, 1.0),
                   ("the harm in standard deviations", harm_sigma, 0.0, math.inf),
@@ -93,9 +93,9 @@ class Requirement:
         self.tol = bias.tolerance_vector(robot, self.tolerances, omitted_params(robot))
         self.invisible = None  # unknown until :meth:`find_invisible`
         #: the zero offsets' range an order error's harm is judged over (q-units): what the fit check's
-        #: plausibility accepts (:data:`zerocal_sym.identify.fitcheck.DEFAULT_MAX_OFFSET`, 10 deg or 10 mm)
+        #: plausibility accepts (:data:`zerocal_sym.identify.check.plausibility.DEFAULT_MAX_OFFSET`, 10 deg or 10 mm)
         from zerocal_sym.design.terms import _qscale, offset_positions
-        from zerocal_sym.identify.fitcheck import DEFAULT_MAX_OFFSET
+        from zerocal_sym.identify.check.plausibility import DEFAULT_MAX_OFFSET
         from zerocal_sym.model import units
 
         unit = robot.errors.offset_user_unit
@@ -313,7 +313,7 @@ def _exact_orders(robot, T, noise, lam, kinds, harmless, lam_req):
     rows = sorted(rows, key=lambda j: lam[j])[:MAX_EXACT_REFITS]  # the least visible first
     if not rows or not math.isfinite(lam_req):
         return out
-    from zerocal_sym.identify.exact_refits import _Exact
+    from zerocal_sym.identify.estimate.exact_model import _Exact
 
     K = len(T.rho)
     readings = np.concatenate([[0.0], np.diff(T.rho)])

@@ -365,7 +365,7 @@ def optimize_design(robot, K: int = 6, criterion: str = "crlb", cons: Constraint
         :func:`zerocal_sym.design.exchange.candidate_grid`).
     tolerances : dict name -> value (internal units), optional
         Tolerances of the omitted errors (``mse`` and the bias report;
-        default :func:`zerocal_sym.identify.bias.default_tolerances`).
+        default :func:`zerocal_sym.identify.budget.bias.default_tolerances`).
     method : {"auto", "exact", "approx"}
     certificate : bool
     progress : callable, optional

@@ -18,7 +18,7 @@ The errors a design is judged against (:func:`scenario_effects`), at zero source
 design's linearisation point):
 
 * **robot-file entries** (the source errors the identification holds at zero) each at its tolerance
-  (:func:`zerocal_sym.identify.bias.make_tolerances`: the mechanism's defaults, or the robot file's,
+  (:func:`zerocal_sym.identify.budget.bias.make_tolerances`: the mechanism's defaults, or the robot file's,
   and ``--tolerance``): ``delta = D a_o t_j``; and **every length of the robot file** off by the same
   fraction (:func:`scale_column`, a file for another robot of the family, or in other units);
 * **the poses visited in reverse order**, and **two consecutive poses swapped** (each pair): the
@@ -27,7 +27,7 @@ design's linearisation point):
 
 The order scenarios are gross (tens of mm on a reading): their non-centrality is also computed on the
 exact model (:func:`detection`: the exact Gauss-Newton fit of the noise-free readings of the wrong
-order, :meth:`zerocal_sym.identify.exact_refits._Exact.chi2_fit`, as the fit check's diagnosis refits
+order, :meth:`zerocal_sym.identify.estimate.exact_model._Exact.chi2_fit`, as the fit check's diagnosis refits
 them), and the smaller of the two is reported.
 
 What a checked design must see is :mod:`zerocal_sym.design.detection`'s (its :class:`Requirement`).
@@ -40,7 +40,7 @@ import numpy as np
 
 from zerocal_sym.identify.chi2 import chi2_sf
 
-#: the fit check's level (:data:`zerocal_sym.identify.fitstats.DEFAULT_ALPHA`)
+#: the fit check's level (:data:`zerocal_sym.identify.check.statistics.DEFAULT_ALPHA`)
 DEFAULT_ALPHA = 1e-3
 #: the power a checked design keeps against every scenario it must see
 DEFAULT_POWER = 0.9

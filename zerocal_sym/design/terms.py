@@ -293,11 +293,11 @@ def _tolerance_columns(robot, tolerances):
     """Scale of the omitted-error sensitivities for the bias, shape (r,).
 
     ``t_j / sqrt(3)`` (the RMS of a uniform error) for the ``rms`` bias model,
-    ``t_j`` for ``worst`` (:class:`zerocal_sym.identify.bias.Tolerances`).
+    ``t_j`` for ``worst`` (:class:`zerocal_sym.identify.budget.bias.Tolerances`).
     ``tolerances``: dict name -> value (internal units) or None for the
-    defaults (:func:`zerocal_sym.identify.bias.default_tolerances`).
+    defaults (:func:`zerocal_sym.identify.budget.bias.default_tolerances`).
     """
-    from zerocal_sym.identify import bias
+    from zerocal_sym.identify.budget import bias
 
     tol = bias.default_tolerances(robot, design_params(robot)) if tolerances is None else tolerances
     t = bias.tolerance_vector(robot, tol, omitted_params(robot))

@@ -2,10 +2,10 @@
 
 For Monte Carlo studies and design verification: the K commanded poses are
 the same for every data set, only the readings differ.  The Gauss-Newton
-iterations of :mod:`zerocal_sym.identify.nlls_problem` are mapped over the N
+iterations of :mod:`zerocal_sym.identify.estimate.nlls_problem` are mapped over the N
 data sets (``Function.map``) and evaluated in one zero-copy call; each data
 set is *confirmed* when its last Gauss-Newton step is below
-:data:`~zerocal_sym.identify.nlls_solve.GN_STEP_TOL` (the same criterion as the
+:data:`~zerocal_sym.identify.estimate.nlls_solve.GN_STEP_TOL` (the same criterion as the
 single path uses before Ipopt confirms).  A data set that is not confirmed
 goes through :func:`zerocal_sym.identify.nlls.identify_nlls` (Ipopt the judge).
 The estimates of confirmed data sets equal the single path's to the
@@ -19,10 +19,10 @@ import numpy as np
 
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify import fisher
-from zerocal_sym.identify.nlls import identify_nlls, noise_terms
-from zerocal_sym.identify.nlls_inputs import index_list
-from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
-from zerocal_sym.identify.nlls_problem import GN_BLOCKS, get_problem
+from zerocal_sym.identify.estimate.nlls_inputs import index_list
+from zerocal_sym.identify.estimate.nlls_problem import GN_BLOCKS, get_problem
+from zerocal_sym.identify.estimate.nlls_solve import GN_STEP_TOL, noise_terms
+from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel
 

@@ -5,13 +5,22 @@ Both are the regularised incomplete gamma function :func:`_gamma_pq`
 (``P(dof/2, x/2)``, ``Q(dof/2, x/2)``): a series below ``a + 1``, Lentz's
 continued fraction above, :func:`math.lgamma`; accurate to ~1e-14 relative
 (``tests/test_fitcheck.py`` compares them with ``scipy.stats.chi2``).  Used by
-the fit check (:mod:`zerocal_sym.identify.fitcheck`, :mod:`~zerocal_sym.identify.fitstats`,
-:mod:`~zerocal_sym.identify.diagnosis`) and the p-values of
-:func:`~zerocal_sym.identify.batch.identify_batch`.
+the fit check (:mod:`zerocal_sym.identify.fitcheck`, :mod:`~zerocal_sym.identify.check.statistics`,
+:mod:`~zerocal_sym.identify.diagnose.causes`) and the p-values of
+:func:`~zerocal_sym.identify.batch.identify_batch`; :func:`_fmt_p` prints a p-value.
 """
 from __future__ import annotations
 
 import math
+
+import numpy as np
+
+
+def _fmt_p(p) -> str:
+    """``p = 0.0123``, ``p < 1e-300`` (below the smallest double the tail reaches) or ``p n/a``."""
+    if p is None or not np.isfinite(p):
+        return "p n/a"
+    return "p < 1e-300" if p == 0.0 else f"p = {p:.3g}"
 
 
 def _gamma_pq(a: float, x: float) -> tuple:
@@ -93,8 +102,6 @@ def chi2_sf_array(x, dof) -> "np.ndarray":
     stops changing when it has converged, as the scalar loop breaks), in the same operations and order; the
     logarithms and exponentials of the end are :mod:`math`'s, entry by entry, as there.  NaN in, NaN out.
     """
-    import numpy as np
-
     dof = float(dof)
     if not (dof > 0 and math.isfinite(dof)):
         raise ValueError(f"chi2_sf_array: dof must be positive, got {dof}")

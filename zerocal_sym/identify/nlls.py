@@ -38,6 +38,13 @@ Priors and bounds
     rad / mm): the estimate is then the MAP.  Optional bounds in the same
     units.  The NLP is built once per (mechanism, K, parameter set) and cached:
     data, weights, geometry, fixed errors and priors are NLP parameters.
+
+The stages composed here: the estimate (:mod:`zerocal_sym.identify.estimate`:
+the inputs, the CasADi problem, Gauss-Newton and Ipopt's verdict, the fit
+with the revisits' shared error), a robust loss's outliers
+(:mod:`~zerocal_sym.identify.nlls_robust`), the fit check and its diagnosis
+(:mod:`~zerocal_sym.identify.fitcheck`), the limits of a robust fit
+(:mod:`~zerocal_sym.identify.check.robust_fit`).
 """
 from __future__ import annotations
 
@@ -45,25 +52,24 @@ import time
 
 import numpy as np
 
-from zerocal_sym.identify import fisher, fitcheck
-from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _Linear, _noise_dict
+from zerocal_sym.identify import banded, fisher
+from zerocal_sym.identify.check.robust_fit import limit_outliers, robust_linear, unchecked_after_removal
+from zerocal_sym.identify.check.statistics import DEFAULT_ALPHA
+from zerocal_sym.identify.estimate import robust as rb
+from zerocal_sym.identify.estimate.nlls_banded import round_problem
+from zerocal_sym.identify.estimate.nlls_inputs import (_as_vector, check_measurements, initial, prior_whitener,
+                                                      scaled_bounds)
+from zerocal_sym.identify.estimate.nlls_problem import get_problem
+from zerocal_sym.identify.estimate.nlls_shared import revisit_stage, revisits_entry
+from zerocal_sym.identify.estimate.nlls_solve import information, noise_terms, solve, status_line
+from zerocal_sym.identify.fitcheck import check_result
+from zerocal_sym.identify.nlls_robust import robust_stage
+from zerocal_sym.identify.result import IdentificationResult, _noise_dict
+from zerocal_sym.identify.whitened import _Linear
 from zerocal_sym.model.noise import NoiseModel
-from zerocal_sym.identify.nlls_inputs import (_as_vector, check_measurements, initial, prior_whitener,
-                                             scaled_bounds)
-from zerocal_sym.identify.nlls_banded import round_problem
-from zerocal_sym.identify.nlls_problem import get_problem
-from zerocal_sym.identify.nlls_solve import UNIT_SIGMA_MM, information, robust_stage, solve, status_line
-from zerocal_sym.identify.result import IdentificationResult
 
-#: losses of identify_nlls (robust ones: zerocal_sym.identify.robust)
+#: losses of identify_nlls (robust ones: zerocal_sym.identify.estimate.robust)
 LOSSES = ("l2", "huber", "soft_l1")
-
-
-def noise_terms(noise: NoiseModel):
-    """``(sigma_m^2, sigma_xi^2)`` of the whitening; a zero model weights every change by 1 um."""
-    if noise.is_zero:
-        return UNIT_SIGMA_MM**2, 0.0
-    return float(noise.sigma_scale_mm) ** 2, float(noise.sigma_servo_rad) ** 2
 
 
 def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, prior=None,
@@ -114,11 +120,11 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     loss : {"l2", "huber", "soft_l1"}
         ``l2`` (default): the Gaussian likelihood, solved as below.  A robust
         loss starts from the l2 solution and runs iteratively reweighted
-        Gauss-Newton on the exact model (:mod:`zerocal_sym.identify.robust`:
+        Gauss-Newton on the exact model (:mod:`zerocal_sym.identify.estimate.robust`:
         each reading judged by its conditional residual given the others, so
         the servo error's correlation does not spread a bad reading).
         Readings whose weight ends below
-        :data:`~zerocal_sym.identify.fitcheck.ROBUST_EXCLUDE_WEIGHT` are
+        :data:`~zerocal_sym.identify.check.robust_fit.ROBUST_EXCLUDE_WEIGHT` are
         outliers: named in the status, the estimate refitted without them
         (its covariance that of the readings kept), left out of the fit
         check.  Otherwise the covariance is the inverse of the information
@@ -136,10 +142,10 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         despite misfit ...").
 
     Solution: ``N_GN`` damped Gauss-Newton iterations inside one CasADi
-    call (:mod:`zerocal_sym.identify.nlls_problem`), then Ipopt's verdict on
+    call (:mod:`zerocal_sym.identify.estimate.nlls_problem`), then Ipopt's verdict on
     that point, whose status decides ``success`` (Ipopt is the judge): a
     converged point without bounds that passes Ipopt's own termination test
-    at a start (:func:`~zerocal_sym.identify.nlls_solve.ipopt_accepts`, on
+    at a start (:func:`~zerocal_sym.identify.estimate.nlls_solve.ipopt_accepts`, on
     the Jacobian and residuals already computed) gets what Ipopt returns
     there (``Solve_Succeeded``, 0 iterations); otherwise Ipopt solves from it
     (0-1 iterations from a converged point).  If Gauss-Newton did not
@@ -166,8 +172,6 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
         raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     delta = None
     if loss != "l2":
-        from zerocal_sym.identify import robust as rb
-
         delta = rb.DEFAULT_SCALE[loss] if loss_scale is None else float(loss_scale)
         if not delta > 0:
             raise ValueError(f"loss_scale must be positive, got {loss_scale!r}")
@@ -195,8 +199,6 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     sol = solve(prob, z0, par, reweight, bounds is not None, lbx, ubx, max_iter, K)
     sol.cov = sol.A = None
     if noise.has_shared and not noise.is_zero:  # the full covariance (not tridiagonal): on from the banded fit
-        from zerocal_sym.identify.nlls_shared import revisit_stage
-
         revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale, K,
                       *((lbx, ubx) if bounds is not None else ()))
     robust = A = None
@@ -259,7 +261,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
                       terms=terms)
         at = "estimate"
     else:
-        lin = rb.robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
+        lin = robust_linear(robust, s - pred, A, J[K - 1:][rows], rp[rows], scale, names, K)
         at = ("estimate, without the readings the robust loss down-weighted (at pose "
               f"{', '.join(map(str, robust['excluded_readings']))})" if robust["excluded_readings"] else "estimate")
         info["robust"] = {k: v for k, v in robust.items() if not k.startswith("_")}
@@ -267,76 +269,14 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     tol_b = 1e-7 * (1.0 + np.abs(z))
     active = [] if bounds is None else [n for n, zz, lo, hi, tb in zip(names, z, lbx, ubx, tol_b)
                                         if zz <= lo + tb or zz >= hi - tb]
-    fitcheck.check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
-                          prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
+    check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
+                 prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     if robust is not None:
-        _limit_outliers(res, robust, loss, K, accept_misfit)
-        _unchecked_after_removal(res, robust, loss, K, accept_misfit)
-    from zerocal_sym.identify.nlls_shared import revisits_entry
-
+        limit_outliers(res, robust, loss, K, accept_misfit)
+        unchecked_after_removal(res, robust, loss, K, accept_misfit)
     revisits_entry(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)
     info["time_s"] = time.perf_counter() - t0
     return res
-
-
-def _unchecked_after_removal(res, robust, loss, K, accept_misfit):
-    """Refuse a robust fit that left no spare degree of freedom once its outliers were left out.
-
-    Without a spare degree of freedom the fit check cannot test what is left
-    (any readings fit), so nothing says the readings left out were the bad
-    ones: with one reading 0.18 mm off on a Delta ring of K = 8 the Huber
-    loss left out a good one and the offsets came out 2.5 deg off with a
-    1 sigma of 0.07 deg.  ``accept_misfit`` keeps it, saying so.
-    """
-    fit = res.info["fit"]
-    if not robust["excluded_readings"] or fit.get("checked") or fit.get("dof", 1) > 0 or not res.success:
-        return
-    poses = ", ".join(map(str, robust["excluded_readings"]))
-    why = (f"the {loss} loss left out the reading(s) at pose {poses}, and the {K - 1 - len(robust['excluded_readings'])}"
-           f" readings left give no spare degree of freedom: the fit cannot be checked, so nothing shows that the "
-           "readings left out were the bad ones")
-    fit["unchecked_after_removal"] = True
-    if accept_misfit:
-        res.status = f"accepted despite misfit (unchecked: {why}); {res.status}"
-        fit["accepted_despite_misfit"] = True
-    else:
-        res.success = False
-        res.status = f"rejected: {why}"
-        fit["rejected"] = True
-    fit["diagnosis"] = (f"The {loss} loss left out the reading(s) at pose {poses}; the readings left fit any "
-                        "parameters exactly (no spare degree of freedom), so the fit is not checked. Measure more "
-                        "poses (or re-measure the pose(s) left out) and identify again; --accept-misfit keeps it "
-                        "unchecked.")
-
-
-def _limit_outliers(res, robust, loss, K, accept_misfit):
-    """Reject a robust fit that left out more readings than :func:`fitcheck.robust_exclusion_limit` allows.
-
-    A robust loss copes with a bad reading or a few; when it down-weights many,
-    the fit of the rest is not evidence for the estimate (with a wrong robot
-    file, 3 of 5 readings left out and the other 2 fitted by 1 parameter
-    "passed" the check).  ``accept_misfit`` keeps it, saying so.
-    """
-    n_out, limit = len(robust["excluded_readings"]), fitcheck.robust_exclusion_limit(K - 1)
-    res.info["fit"]["robust_exclusion_limit"] = limit
-    if n_out <= limit or not res.success:
-        return
-    why = (f"the {loss} loss left out {n_out} of the {K - 1} readings (at most {limit}: a robust loss copes with "
-           "a bad reading or a few, not with a model that does not fit the data: the robot file, the parameters "
-           "estimated, the noise model)")
-    if accept_misfit:
-        res.status = f"accepted despite misfit ({why}); {res.status}"
-        res.info["fit"]["accepted_despite_misfit"] = True
-    else:
-        res.success = False
-        res.status = f"rejected: {why}"
-    fit = res.info["fit"]
-    fit["rejected"] = True
-    kept = fit.get("diagnosis") or ""
-    fit["diagnosis"] = (f"The {loss} loss left out the readings at pose "
-                        f"{', '.join(map(str, robust['excluded_readings']))}: more than {limit} of {K - 1}, so the "
-                        "data do not fit the model, whatever the few readings left say"
-                        + (f" (of those: {kept[0].lower() + kept[1:]})" if kept else "."))
 
 
 def make_nlls_identifier(params="paper", noise: NoiseModel | None = None, sequential: bool = False, **kwargs):
@@ -431,8 +371,6 @@ def residual_problem(robot, meas, params="paper", noise: NoiseModel | None = Non
         rfun, jfun = prob.functions["rfun"], prob.functions["jfun"]
         fun, jac = (lambda z: rfun(z, par, l, b).full().ravel()), (lambda z: jfun(z, par, l, b).full())
     if noise.has_shared and not noise.is_zero:  # the full covariance at the prior: W L0 (L0 r = the residuals)
-        from zerocal_sym.identify import banded
-
         C = fisher.change_covariance(robot, theta_cmd, noise, prior_q)
         return ((lambda z: C.whiten(banded.times_factor(l, b, fun(z)))),
                 (lambda z: C.whiten(banded.times_factor(l, b, np.reshape(jac(z), (theta_cmd.shape[0] - 1, -1))))),

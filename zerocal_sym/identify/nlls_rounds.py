@@ -3,12 +3,12 @@
 :func:`identify_rounds` takes one measurement round per loop (each its own commanded joints, after its own
 compensation, and its own prior: the loop's current totals, for a sequential MAP the previous round's
 covariance) and runs the Gauss-Newton blocks of all of them in one mapped call per block
-(:meth:`~zerocal_sym.identify.nlls_problem.NllsProblem.run_batch`: every column evaluated as the single
+(:meth:`~zerocal_sym.identify.estimate.nlls_problem.NllsProblem.run_batch`: every column evaluated as the single
 Function evaluates it).  A round whose Gauss-Newton converged and passes Ipopt's own first-order test
-(:func:`~zerocal_sym.identify.nlls_solve.ipopt_accepts`, as ``identify_nlls`` confirms it) gets the
+(:func:`~zerocal_sym.identify.estimate.nlls_solve.ipopt_accepts`, as ``identify_nlls`` confirms it) gets the
 estimate, covariance and verdict ``identify_nlls`` would give, from the same functions on the same arrays
-(:func:`~zerocal_sym.identify.nlls_solve.information`, the fit check's chi² test
-:func:`~zerocal_sym.identify.fitstats.chi2_test`): the same numbers, bit for bit.  Every other round goes
+(:func:`~zerocal_sym.identify.estimate.nlls_solve.information`, the fit check's chi² test
+:func:`~zerocal_sym.identify.check.statistics.chi2_test`): the same numbers, bit for bit.  Every other round goes
 through :func:`~zerocal_sym.identify.nlls.identify_nlls` itself.
 
 What a loop reads of a round (``lean`` results): ``success``, ``status``, the estimate and covariance,
@@ -24,11 +24,13 @@ import numpy as np
 
 from zerocal_sym.errors import IdentificationError, ZerocalError
 from zerocal_sym.identify import fisher
-from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, RANK_RTOL, _Linear, chi2_test
-from zerocal_sym.identify.nlls_inputs import prior_whitener
-from zerocal_sym.identify.nlls_problem import EXPAND_MAX_K, GN_BLOCKS, get_problem
-from zerocal_sym.identify.nlls_solve import GN_STEP_TOL, information, ipopt_accepts, status_line
+from zerocal_sym.identify.check.statistics import DEFAULT_ALPHA, chi2_test
+from zerocal_sym.identify.estimate.nlls_inputs import prior_whitener
+from zerocal_sym.identify.estimate.nlls_problem import EXPAND_MAX_K, GN_BLOCKS, get_problem
+from zerocal_sym.identify.estimate.nlls_solve import (GN_STEP_TOL, information, ipopt_accepts, noise_terms,
+                                                     status_line)
 from zerocal_sym.identify.result import IdentificationResult
+from zerocal_sym.identify.whitened import RANK_RTOL, _Linear
 
 
 def _blocks(prob, z, P):
@@ -58,8 +60,8 @@ def _blocks(prob, z, P):
 
 
 class _Verdict:
-    """What :func:`~zerocal_sym.identify.fitstats.chi2_test` reads of a :class:`_Linear` without prior rows, from
-    the SVD ``svd`` of the Jacobian already computed: ``r``, ``valid``, ``dof`` (the same definitions)."""
+    """What :func:`~zerocal_sym.identify.check.statistics.chi2_test` reads of a :class:`_Linear` without prior rows,
+    from the SVD ``svd`` of the Jacobian already computed: ``r``, ``valid``, ``dof`` (the same definitions)."""
 
     def __init__(self, r, Jd, l, b, svd):
         self.r = r
@@ -126,7 +128,7 @@ def identify_rounds(robot, rounds, priors, params, noise, prior_covs=None, alpha
         Per round its :class:`IdentificationResult` (lean when confirmed in the batch, see the module), or the
         :class:`IdentificationError` / :class:`ZerocalError` ``identify_nlls`` raised for it.
     """
-    from zerocal_sym.identify.nlls import identify_nlls, noise_terms
+    from zerocal_sym.identify.nlls import identify_nlls
 
     n = len(rounds)
     prior_covs = [None] * n if prior_covs is None else list(prior_covs)

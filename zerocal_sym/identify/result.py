@@ -143,6 +143,14 @@ class IdentificationResult(units.DegreeViews):
         }
 
 
+def _noise_dict(noise) -> dict:
+    """The noise model as a result records it (``info["noise"]``, ``info["fit"]["noise"]``)."""
+    d = {"sigma_scale_mm": float(noise.sigma_scale_mm), "sigma_servo_rad": float(noise.sigma_servo_rad)}
+    if getattr(noise, "sigma_revisit_mm", 0):
+        d["sigma_revisit_mm"] = float(noise.sigma_revisit_mm)
+    return d
+
+
 def _json_ready(obj):
     """Plain Python (dicts, lists, floats, None for non-finite numbers) of a nested structure."""
     if isinstance(obj, dict):

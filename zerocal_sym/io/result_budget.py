@@ -8,7 +8,7 @@ of its ``dominant_entries``' contributions (each ``|sensitivity| x
 tolerance`` of a robot-file entry of the mechanism that is not a zero
 offset); ``limited_by`` is ``"data"`` or ``"robot file"``, the latter exactly
 when some offset's ``robot_file_bias`` exceeds its ``noise_std`` (the rule of
-:func:`zerocal_sym.identify.budget.limited_by`).
+:func:`zerocal_sym.identify.budget.error_budget.limited_by`).
 """
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ def _where(text, key, src):
     return f"{src}:{line}" if line else src
 
 
-#: the values of ``limited_by`` (:data:`zerocal_sym.identify.budget.LIMITS`)
+#: the values of ``limited_by`` (:data:`zerocal_sym.identify.budget.error_budget.LIMITS`)
 LIMITED_BY = ("data", "robot file")
 
 

@@ -4,8 +4,8 @@ An identification estimates some source errors (the zero offsets and the
 MAEMM by default) and holds every other one at the robot file's value.  A
 tolerance ``t`` states how far the real robot may be from the file for an
 entry held so: ``|e| <= t`` (mm; deg for angles).  The bias this can put on
-the estimate is :mod:`zerocal_sym.identify.bias`'s; the error budget of an
-answer is :mod:`zerocal_sym.identify.budget`'s.
+the estimate is :mod:`zerocal_sym.identify.budget.bias`'s; the error budget of an
+answer is :mod:`zerocal_sym.identify.budget.error_budget`'s.
 
 The table
 ---------

@@ -1,23 +1,25 @@
-"""The exact whitened model of one identification problem, and exact-model refits without readings.
+"""The exact whitened model of one identification problem: evaluated, linearised, refined, refitted.
 
 :class:`_Exact` evaluates the residuals and Jacobian of the exact model (the
-CasADi functions of :mod:`zerocal_sym.identify.nlls_problem`, imported when
-used, not with this module: nlls_problem imports the fit check), linearises
-it for the fit check (:class:`~zerocal_sym.identify.fitstats._Linear`),
-refines an estimate by Gauss-Newton and refits altered data (the causes of a
-rejection, :mod:`zerocal_sym.identify.diagnosis`).  The refits without
-readings are :mod:`zerocal_sym.identify.leave_out`'s (:func:`refits`, a few
-fits each without some readings; the robust loss's outliers):
-:func:`_without_each` is the fit without each single reading from the prior
-and from the estimate (the deletion diagnostics, the bad reading of a
-rejection).
+CasADi functions of :mod:`zerocal_sym.identify.estimate.nlls_problem`, the
+numpy twin of :mod:`~zerocal_sym.identify.estimate.nlls_banded` for long
+rounds), linearises it for the fit check
+(:class:`~zerocal_sym.identify.whitened._Linear`), refines an estimate by
+Gauss-Newton (TSVD's fit check point, its truncated directions) and fits
+altered data from the prior (the causes of a rejection:
+:mod:`zerocal_sym.identify.diagnose.causes`).  :func:`_exact_for` is the
+exact model of a result, at its fit check's point.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym.identify.fitstats import RANK_RTOL, _Linear
-from zerocal_sym.identify.leave_out import _Round, refits, without_each  # noqa: F401 - refits importable from here
+from zerocal_sym.identify import fisher
+from zerocal_sym.identify.estimate.nlls_banded import round_problem
+from zerocal_sym.identify.estimate.nlls_shared import pred_jacobian
+from zerocal_sym.identify.estimate.nlls_solve import GN_STEP_TOL, noise_terms
+from zerocal_sym.identify.whitened import RANK_RTOL, _Linear
+from zerocal_sym.model.noise import NoiseModel
 
 #: exact-model refinement (TSVD) stops when its step (scaled units, mm) is below this
 REFINE_TOL = 1e-9
@@ -27,10 +29,6 @@ class _Exact:
     """The exact whitened model of one identification problem (robot, poses, readings, parameters)."""
 
     def __init__(self, robot, theta_cmd, readings, names, prior_q, noise, prior_whitener=None):
-        from zerocal_sym.identify import fisher
-        from zerocal_sym.identify.nlls import noise_terms
-        from zerocal_sym.identify.nlls_banded import round_problem
-
         self.robot = robot
         self.theta = np.atleast_2d(np.asarray(theta_cmd, float))
         self.readings = np.asarray(readings, float)
@@ -67,8 +65,6 @@ class _Exact:
         r, rp, J, pred = (np.array(o, float) for o in fast["residuals"](z, self.par, l, b))
         r, J, pred, l, b = r.ravel(), np.reshape(J, (-1, np.size(z))), pred.ravel(), l.ravel(), b.ravel()
         if self.shared:
-            from zerocal_sym.identify.nlls_shared import pred_jacobian
-
             C = self.covariance(z)
             J = np.vstack([C.whiten(-pred_jacobian(l, b, J, self.K)), J[self.K - 1:]])
             r = C.whiten(self.readings[1:] - pred)
@@ -76,15 +72,11 @@ class _Exact:
 
     def covariance(self, z):
         """The covariance of the changes at ``z`` (:func:`~zerocal_sym.identify.fisher.change_covariance`)."""
-        from zerocal_sym.identify.fisher import change_covariance
-
         err = self.robot.errors.put(self.prior_q, self.names, np.asarray(z, float) / self.scale)
-        return change_covariance(self.robot, self.theta, self.noise, err)
+        return fisher.change_covariance(self.robot, self.theta, self.noise, err)
 
     def raw(self, z):
         """``(e, A)`` at ``z``: the residuals of the changes (mm) and ``d pred / d z`` (K-1, p)."""
-        from zerocal_sym.identify.nlls_shared import pred_jacobian
-
         fast = self.prob.fast
         l, b = (np.array(o, float) for o in fast["weights"](z, self.par))
         _, _, J, pred = (np.array(o, float) for o in fast["residuals"](z, self.par, l, b))
@@ -106,8 +98,6 @@ class _Exact:
 
     def refine(self, z0, basis=None, max_iter: int = 10):
         """Gauss-Newton on the exact model from ``z0`` within ``span(basis)`` (weights re-evaluated)."""
-        from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
-
         z = np.asarray(z0, float).copy()
         if not self.shared and (basis is None or (np.shape(basis)[1] == self.p and not np.any(self.w))):
             # the whole space: the nlls problem's Gauss-Newton blocks (one CasADi call per 3 iterations)
@@ -150,8 +140,6 @@ class _Exact:
             par[: self.theta.size] = np.asarray(theta, float).ravel()
         if readings is not None:
             par[self.prob.s_slice(len(self.robot.geometry), len(self.robot.errors))] = np.asarray(readings)[1:]
-        from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
-
         out = self.prob.run_gauss_newton(self.z_prior, par, True, GN_STEP_TOL)
         r, rp = np.array(out[2]).ravel(), np.array(out[3]).ravel()
         rows = self.prior_rows()
@@ -166,15 +154,16 @@ class _Exact:
         return (chi2 if np.isfinite(chi2) else float("inf")), dof
 
 
-def _without_each(exact: "_Exact", z_est=None, select=None) -> dict:
-    """Exact refits without each single reading, from the prior and from ``z_est``; the lower chi² per reading
-    (:func:`~zerocal_sym.identify.leave_out.without_each`; ``select``: the readings refitted exactly).  With
-    the revisits' shared error: :func:`zerocal_sym.identify.revisit_refits.without_each_shared`."""
-    if exact.shared:
-        from zerocal_sym.identify.revisit_refits import without_each_shared
-
-        return without_each_shared(exact, z_est, select)
-    starts = [exact.z_prior] if z_est is None or np.allclose(z_est, exact.z_prior) else [exact.z_prior, z_est]
-    rnd = _Round(exact.robot, exact.theta, exact.readings, exact.names, exact.prior_q, exact.noise,
-                 exact.w if np.any(exact.w) else None)
-    return without_each(rnd, starts, select=select)
+def _exact_for(robot, meas, result, noise=None) -> tuple:
+    """(_Exact, z at the fit check's evaluation point, basis) of a result."""
+    info = result.info
+    if noise is None:
+        nd = info.get("noise")
+        noise = NoiseModel.from_dict(nd) if nd else NoiseModel.paper()
+    prior_q = np.asarray(info.get("prior", robot.errors.zeros()), float)
+    w = info.get("prior_whitener")
+    exact = _Exact(robot, meas.theta_cmd, meas.readings, result.params, prior_q, noise,
+                   None if w is None else np.asarray(w, float))
+    z = np.asarray(info.get("fit_point", result.estimate), float) * exact.scale
+    basis = info.get("fit_basis")
+    return exact, z, (None if basis is None else np.asarray(basis, float))

@@ -2,9 +2,9 @@
 
 :func:`solve` (Gauss-Newton inside one CasADi call, then Ipopt's verdict:
 its own termination test at a converged Gauss-Newton point, or its solve),
-:func:`robust_stage` (a robust loss from the l2 solution),
 :func:`information` (rank, covariance and null space from one SVD of the
-whitened, scaled Jacobian) and :func:`status_line`.  Shapes: K poses, p
+whitened, scaled Jacobian), :func:`status_line` and :func:`noise_terms` (the
+noise model's terms of the whitening).  Shapes: K poses, p
 estimated parameters.
 """
 from __future__ import annotations
@@ -13,8 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from zerocal_sym.identify import banded
-from zerocal_sym.identify.fitstats import RANK_RTOL
+from zerocal_sym.identify.whitened import RANK_RTOL
 
 #: weighting of noise-free data (``NoiseModel()``): residuals in units of 1 um
 UNIT_SIGMA_MM = 1e-3
@@ -31,10 +30,17 @@ CONFIRM = "test"
 CONFIRM_MARGIN = 0.5
 
 
+def noise_terms(noise):
+    """``(sigma_m^2, sigma_xi^2)`` of the whitening; a zero model weights every change by 1 um."""
+    if noise.is_zero:
+        return UNIT_SIGMA_MM**2, 0.0
+    return float(noise.sigma_scale_mm) ** 2, float(noise.sigma_servo_rad) ** 2
+
+
 def ipopt_accepts(J, r, rp, K) -> bool:
     """Would Ipopt, started at this point, stop there at once (``Solve_Succeeded`` after 0 iterations)?
 
-    Ipopt's NLP here (:mod:`~zerocal_sym.identify.nlls_problem`) is unconstrained, without bounds, unscaled
+    Ipopt's NLP here (:mod:`~zerocal_sym.identify.estimate.nlls_problem`) is unconstrained, without bounds, unscaled
     (``nlp_scaling_method none``), with the objective ``0.5 c |[r; rp]|^2``, ``c = 1 / |J_data|_F^2``.  At its
     starting point, before any iteration, Ipopt checks convergence first (before its iteration limit): with
     no constraints, bounds or multipliers its optimality error is the largest entry of the gradient
@@ -42,7 +48,7 @@ def ipopt_accepts(J, r, rp, K) -> bool:
     the point unchanged, when that is at most ``ipopt.tol``.  This is that test, with the margin
     :data:`CONFIRM_MARGIN`; ``J`` (K-1 + p, p), ``r`` (K-1,), ``rp`` (p,).
     """
-    from zerocal_sym.identify.nlls_problem import IPOPT_OPTIONS
+    from zerocal_sym.identify.estimate.nlls_problem import IPOPT_OPTIONS
 
     Jd = J[: K - 1]
     c = 1.0 / max(1e-300, float(np.vdot(Jd, Jd)))
@@ -107,38 +113,6 @@ def solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleName
                            iterations=total_iter, gn_ok=gn_ok, step=step, l=l, b=b, r=r.ravel(), rp=rp.ravel(),
                            J=np.reshape(J, (-1, z.size)), pred=pred.ravel(),  # (a column when p = 1)
                            confirmation="ipopt")
-
-
-def robust_stage(prob, par, sol, robot, meas, theta_cmd, names, prior_q, noise, loss, delta, w, z_prior, K):
-    """The robust loss from the l2 solution ``sol`` (or from the prior when Ipopt failed: an outlier can
-    cause that); updates ``sol`` in place (point, status, weights, residuals, and ``J`` to the information of
-    the readings kept or with the final robust weights).  Returns ``(robust, A)``: the robust stage's record
-    and ``d pred / d z`` (K-1, p)."""
-    from zerocal_sym.identify import robust as rb
-
-    fast = prob.fast
-    z_start = sol.z if (sol.converged and np.all(np.isfinite(sol.z))) else z_prior
-    z, robust, ok = rb.robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_start, loss, delta, w, K)
-    robust["l2_solver_status"] = sol.ret
-    if not ok:
-        sol.converged, sol.ret = False, "robust iteration did not converge"
-    elif not sol.converged:
-        sol.converged, sol.ret = True, f"robust iteration converged; the l2 Ipopt solve: {sol.ret}"
-    sol.z = z
-    l, b = (np.array(o) for o in fast["weights"](z, par))
-    r, rp, J, pred = (np.array(o) for o in fast["residuals"](z, par, l, b))
-    J = np.reshape(J, (-1, z.size))
-    A = -banded.times_factor(np.ravel(l), np.ravel(b), J[: K - 1])   # d pred / d z = -L J
-    excl = np.asarray(robust["excluded_readings"], int) - 1
-    if robust["refit_without_outliers"]:  # information of the readings kept
-        keep = np.setdiff1d(np.arange(K - 1), excl)
-        Jk = np.zeros((K - 1, len(names)))
-        Jk[: keep.size] = robust["_C"].take(keep).whiten(-A[keep])
-    else:  # information with the final robust weights: the data rows whitened by chol(C_w)
-        Jk = robust["_C_w"].whiten(-A)
-    sol.l, sol.b, sol.r, sol.rp, sol.pred = l, b, r.ravel(), rp.ravel(), pred.ravel()
-    sol.J = np.vstack([Jk, J[K - 1:]])
-    return robust, A
 
 
 def information(J, Jd, r, K, has_prior, noise, scale, names, errors):

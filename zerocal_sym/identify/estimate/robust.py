@@ -1,8 +1,8 @@
 """Robust identification: iteratively reweighted Gauss-Newton on the exact model.
 
-``identify_nlls(..., loss="huber" | "soft_l1", loss_scale=...)`` calls :func:`robust_stage`, which runs
-:func:`irls` after its l2 solution.  The changes are correlated (consecutive
-changes share a pose's servo error), so a robust loss on the *whitened*
+``identify_nlls(..., loss="huber" | "soft_l1", loss_scale=...)`` runs its robust stage
+(:mod:`zerocal_sym.identify.nlls_robust`), which runs :func:`irls` after its l2 solution.
+The changes are correlated (consecutive changes share a pose's servo error), so a robust loss on the *whitened*
 residuals would not isolate a bad reading (whitening mixes it into the
 following ones).  Instead each reading ``k`` is judged by its **conditional
 residual** -- the measured change minus the model, minus what the other
@@ -22,7 +22,7 @@ distance model and its Jacobians, weights, one Gauss-Newton step of the
 generalised least squares with ``C_w``; until step and weights settle.
 
 Readings whose final weight is below
-:data:`zerocal_sym.identify.fitcheck.ROBUST_EXCLUDE_WEIGHT` are outliers:
+:data:`zerocal_sym.identify.check.robust_fit.ROBUST_EXCLUDE_WEIGHT` are outliers:
 identify_nlls names them, refits the exact model without them and leaves them
 out of the fit check.
 
@@ -39,19 +39,6 @@ import numpy as np
 
 #: default loss scale (standard deviations)
 DEFAULT_SCALE = {"huber": 1.345, "soft_l1": 1.0}
-#: the exact refits without one reading among which the best deletion start is taken: the readings with the
-#: lowest chi² without them in the linearised model
-DELETION_CANDIDATES = 8
-
-
-def lowest(values, k: int) -> np.ndarray:
-    """Bool mask of the ``k`` lowest of ``values`` (non-finite last)."""
-    v = np.asarray(values, float)
-    mask = np.zeros(v.size, bool)
-    mask[np.argsort(np.where(np.isfinite(v), v, np.inf), kind="stable")[:k]] = True
-    return mask
-
-
 def weights(loss: str, u, delta: float) -> np.ndarray:
     """``rho'(u) / u`` of the loss (1 for l2)."""
     u = np.abs(np.asarray(u, float))
@@ -81,7 +68,7 @@ class _Model:
 
     def __init__(self, robot, theta_cmd, readings, names, prior_q, noise, prior_whitener=None):
         from zerocal_sym.identify import fisher
-        from zerocal_sym.identify.nlls import noise_terms
+        from zerocal_sym.identify.estimate.nlls_solve import noise_terms
 
         self.robot = robot
         self.theta = np.atleast_2d(np.asarray(theta_cmd, float))
@@ -188,75 +175,3 @@ def irls(robot, theta_cmd, readings, names, prior_q, noise, z0, loss: str = "hub
     return {"z": z, "objective": float(np.sum(loss_value(loss, u, delta))), "weights": om, "u": u,
             "conditional_residual_mm": c, "C": C, "C_w": C.plus_diagonal(infl), "A": A, "e": e, "iterations": it,
             "converged": bool(converged and np.all(np.isfinite(z)))}
-
-
-def robust_stage(robot, meas, theta_cmd, names, prior_q, noise, z_l2, loss, delta, w, K):
-    """The robust stage of :func:`~zerocal_sym.identify.nlls.identify_nlls` (``z_l2``: its l2 solution, scaled).
-
-    Candidates: IRLS from the l2 solution; IRLS from the best exact fit
-    without one reading (a large outlier drags the l2 solution far along a
-    weak direction); that deletion fit itself, if the loss down-weights the
-    reading it left out there (an outlier with high leverage drags IRLS off
-    it: Huber's loss bounds a reading's influence, not its leverage).  The
-    readings a candidate down-weights below ROBUST_EXCLUDE_WEIGHT are its
-    outliers, and its estimate is the exact fit without them.  Between
-    candidates: one whose fit without its outliers passes the fit check, then
-    the fewest outliers, then the lower robust objective.
-
-    Returns ``(z, info, converged)``.
-    """
-    from zerocal_sym.identify.chi2 import chi2_sf
-    from zerocal_sym.identify.leave_out import _Round, refits, without_each
-    from zerocal_sym.identify.fitcheck import ROBUST_EXCLUDE_WEIGHT
-    from zerocal_sym.identify.fitstats import DEFAULT_ALPHA
-    from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
-
-    pw = w if np.any(w) else None
-    args = (robot, theta_cmd, meas.readings, names, prior_q, noise)
-    cands = [(z_l2, None)]  # (start, the reading a deletion candidate leaves out)
-    if K - 2 > len(names):
-        # the readings with the lowest chi² without them in the linearised model, refitted exactly
-        drop = without_each(_Round(*args, pw), [z_l2], select=lambda c, c0, d: lowest(c, DELETION_CANDIDATES))
-        chi2 = np.where(drop["refitted"], drop["chi2"], np.inf)
-        if np.any(np.isfinite(chi2)):
-            j = int(np.argmin(chi2))
-            cands += [(drop["z"][j], None), (drop["z"][j], j)]
-    best = None
-    for z0, j in cands:
-        out = irls(*args, z0, loss, delta, prior_whitener=pw, max_iter=100 if j is None else 0)
-        if j is None:
-            excl = np.flatnonzero(out["weights"] < ROBUST_EXCLUDE_WEIGHT)
-        else:  # the best single deletion itself (an outlier with high leverage drags IRLS off it)
-            excl = np.array([j]) if out["weights"][j] < ROBUST_EXCLUDE_WEIGHT else np.zeros(0, int)
-            out["converged"] = True
-        ref = refits(*args, [excl], out["z"], prior_whitener=pw, max_iter=50 if excl.size else 0,
-                              tol=GN_STEP_TOL)
-        c, d = float(ref["chi2"][0]), int(ref["dof"][0])
-        passes = bool(d > 0 and np.isfinite(c) and chi2_sf(c, d) >= DEFAULT_ALPHA)
-        key = (bool(out["converged"]), passes, -excl.size, -out["objective"])
-        if best is None or key > best[0]:
-            best = (key, out, excl, ref)
-    _, out, excl, ref = best
-    z, ok = out["z"], out["converged"]
-    C, refit = out["C"], False
-    err_mm = out["conditional_residual_mm"][excl]
-    if ok and excl.size and ref["converged"][0]:  # the outliers named: the estimate is the exact fit without them
-        z, refit = ref["z"][0], True
-        e, _, C = _Model(robot, theta_cmd, meas.readings, names, prior_q, noise, pw).at(z)
-        err_mm = conditional_residuals(e, C, np.zeros(K - 1))[0][excl]
-    return z, {
-        "loss": loss, "scale_sigmas": float(delta), "iterations": int(out["iterations"]),
-        "converged": bool(ok), "weights": out["weights"].tolist(), "standardised": out["u"].tolist(),
-        "excluded_readings": [int(j) + 1 for j in excl], "excluded_errors_mm": [float(v) for v in err_mm],
-        "refit_without_outliers": refit, "_C": C, "_C_w": out["C_w"],
-    }, ok
-
-
-def robust_linear(robust, e, A, Jp, rp, scale, names, K):
-    """The fit check's problem of a robust fit: the readings it down-weighted removed (by marginalising C)."""
-    keep = np.setdiff1d(np.arange(K - 1), np.asarray(robust["excluded_readings"], int) - 1)
-    from zerocal_sym.identify.fitstats import _Linear
-
-    C = robust["_C"].take(keep)  # tridiagonal again
-    return _Linear(np.concatenate([C.whiten(e[keep]), rp]), np.vstack([C.whiten(-A[keep]), Jp]), C.cholesky(),
-                   keep + 1, e[keep], np.eye(len(names)), scale, names, len(rp))

@@ -1,12 +1,11 @@
-"""What a rejected fit check says: its likely causes, the paragraph, the verdict in the result.
+"""The likely causes of a rejected fit, and the paragraph that says them.
 
-:func:`finish` adds the causes (:func:`_diagnose`: the user's bounds or prior
-against the data, readings of the wrong sign or cumulative, poses out of
-order, one bad reading -- each an exact-model refit) and the paragraph
-(``fit["diagnosis"]``) to the statistics of :func:`~zerocal_sym.identify.fitstats.statistics`;
-:func:`apply` records the fit in a result and, when it is rejected, changes
-its ``success`` and ``status``.  The causes and when each is detected:
-:mod:`zerocal_sym.identify.fitcheck`.
+:func:`_diagnose` looks for them (the user's bounds or prior against the
+data, readings of the wrong sign or cumulative, poses out of order, one bad
+reading -- each an exact-model refit) and :func:`_paragraph` writes
+``fit["diagnosis"]``; :mod:`~zerocal_sym.identify.diagnose.verdict` adds them
+to the statistics of :func:`~zerocal_sym.identify.check.statistics.statistics`.
+The causes and when each is detected: :mod:`zerocal_sym.identify.fitcheck`.
 """
 from __future__ import annotations
 
@@ -14,9 +13,9 @@ import math
 
 import numpy as np
 
-from zerocal_sym.identify.chi2 import chi2_sf
-from zerocal_sym.identify.exact_refits import _Exact, _without_each
-from zerocal_sym.identify.fitstats import _fmt_p
+from zerocal_sym.identify.chi2 import _fmt_p, chi2_sf
+from zerocal_sym.identify.diagnose.deletions import _without_each
+from zerocal_sym.identify.estimate.exact_model import _Exact
 
 
 def _variants(K: int, theta, readings):
@@ -180,52 +179,3 @@ def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
         checked = ("Checked and not found: poses visited in reverse or two consecutive poses swapped, cumulative "
                    "readings (head not reset), sign-flipped readings." if exact is not None else "")
     return head + " Likely causes: " + "; ".join(parts) + ". " + checked
-
-
-def _summary(fit: dict) -> str:
-    s = f"chi2 {fit['chi2']:.4g} on {fit['dof']} dof, {_fmt_p(fit['p_value'])}, below {fit['alpha']:g}"
-    det = [c for c in fit.get("causes", []) if c.get("detected")]
-    if det:
-        s += f"; likely: {det[0]['text']}"
-    return s
-
-
-def finish(fit: dict, exact: _Exact | None, diagnose: bool = True, z_est=None) -> dict:
-    """Add the causes and the paragraph to a rejected fit; drop the private arrays."""
-    fit["causes"], fit["diagnosis"] = [], None
-    if fit["rejected"]:
-        if diagnose:
-            fit["causes"], fit["diagnosis"] = _diagnose(exact, fit, fit["alpha"], z_est)
-        else:
-            fit["diagnosis"] = _diagnose(None, fit, fit["alpha"])[1]
-    elif fit["checked"]:
-        fit["diagnosis"] = (f"The fit agrees with the noise model: chi2 = {fit['chi2']:.4g} on {fit['dof']} dof "
-                            f"({_fmt_p(fit['p_value'])}).")
-    else:
-        fit["diagnosis"] = fit["reason"]
-    fit.pop("_t", None)
-    return fit
-
-
-def apply(result, fit: dict, accept_misfit: bool = False):
-    """Record ``fit`` in ``result.info["fit"]`` and, if rejected, change ``status`` / ``success``.
-
-    Only a result that was a calibration (``success``) can be rejected; a
-    failed identification keeps its own status.  Returns ``result``.
-    """
-    result.info["fit"] = fit
-    det = [c for c in fit.get("causes", []) if c.get("detected")]
-    if not result.success and det:  # a failed identification: say what the data look like
-        result.status += f"; the data look wrong: {det[0]['text']} ({det[0]['evidence']})"
-    if fit["rejected"] and result.success:
-        if accept_misfit and math.isfinite(fit["chi2"]):  # (not when the model cannot be evaluated at all)
-            fit["accepted_despite_misfit"] = True
-            result.status = f"accepted despite misfit ({_summary(fit)}); {result.status}"
-        else:
-            result.success = False
-            result.status = (f"rejected: the noise model rejects the fit ({_summary(fit)})"
-                             if math.isfinite(fit["chi2"]) else
-                             "rejected: the exact model cannot be evaluated at the estimate (a pose is not an "
-                             "assembly of the robot with those errors" + (f"; likely: {det[0]['text']})" if det
-                                                                         else ")"))
-    return result

@@ -204,8 +204,8 @@ def tsvd_bias_operator(robot, theta_cmd, prior=None, t=None, rtol=None) -> np.nd
         TSVD's linearisation point: the prior of its (last) step (default zero; an iterated TSVD's last step is
         linearised at its estimate minus its last increment).
     t : int, optional
-        Truncation level (default: the ``threshold`` rule, :data:`~zerocal_sym.identify.truncated_svd.DEFAULT_RTOL`
-        or ``rtol``); give the identification's own ``info["truncation"]`` for another rule.
+        Truncation level (default: the ``threshold`` rule,
+        :data:`~zerocal_sym.identify.estimate.truncated_svd.DEFAULT_RTOL` or ``rtol``); give the identification's own ``info["truncation"]`` for another rule.
 
     Returns
     -------
@@ -213,7 +213,7 @@ def tsvd_bias_operator(robot, theta_cmd, prior=None, t=None, rtol=None) -> np.nd
         Rows the mechanism's default set (zero offsets, measuring errors).
     """
     from zerocal_sym.identify.linear import identification_matrix
-    from zerocal_sym.identify.truncated_svd import DEFAULT_RTOL
+    from zerocal_sym.identify.estimate.truncated_svd import DEFAULT_RTOL
 
     errors = robot.errors
     names = errors.resolve("default")

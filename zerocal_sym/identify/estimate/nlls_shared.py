@@ -1,6 +1,6 @@
 """The weighted fit with the revisits' shared error: Gauss-Newton with the full covariance of the changes.
 
-The CasADi problem of :mod:`zerocal_sym.identify.nlls_problem` whitens by
+The CasADi problem of :mod:`zerocal_sym.identify.estimate.nlls_problem` whitens by
 the bands of the covariance (scale and servo errors: tridiagonal).  A pose's
 systematic error shared by its revisits (``sigma_revisit_mm > 0``) adds
 ``sigma_r^2`` to each pose visited once and a low-rank part per revisited
@@ -13,7 +13,7 @@ covariance, for the information and the fit check.
 
 :func:`revisit_stage` -- the stage; :func:`pred_jacobian` -- ``d pred / d z``
 from the banded problem's whitened Jacobian; :func:`revisits_entry` -- a
-result's ``info["revisits"]`` (:mod:`zerocal_sym.identify.revisits`).
+result's ``info["revisits"]`` (:mod:`zerocal_sym.identify.estimate.revisits`).
 """
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ def revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale
     :data:`MAX_ITER` steps (``sol.ret`` says so).
     """
     from zerocal_sym.identify.fisher import change_covariance
-    from zerocal_sym.identify.nlls_solve import GN_STEP_TOL
+    from zerocal_sym.identify.estimate.nlls_solve import GN_STEP_TOL
 
     errors = robot.errors
     fast = prob.fast
@@ -77,8 +77,8 @@ def revisit_stage(prob, par, sol, robot, theta_cmd, names, prior_q, noise, scale
 
 def revisits_entry(res, robot, theta_cmd, e, sol, A, K, noise, names, prior_q, scale):
     """``info["revisits"]``: the round's revisits and the REML estimate of their shared error (when it has
-    any; :func:`zerocal_sym.identify.revisits.revisit_report`)."""
-    from zerocal_sym.identify.revisits import has_revisits, revisit_report
+    any; :func:`zerocal_sym.identify.estimate.revisits.revisit_report`)."""
+    from zerocal_sym.identify.estimate.revisits import has_revisits, revisit_report
 
     if not has_revisits(robot, theta_cmd):
         return

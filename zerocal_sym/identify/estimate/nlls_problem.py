@@ -41,7 +41,7 @@ import threading
 
 import numpy as np
 
-from zerocal_sym.identify.fitstats import LEVERAGE_TOL
+from zerocal_sym.identify.whitened import LEVERAGE_TOL
 from zerocal_sym.model.compiled import Tier
 from zerocal_sym.model.fastcall import FastCall
 
@@ -121,7 +121,8 @@ def _banded_cholesky(v, sm2):
 
 
 def _fit_terms(n: int, p: int):
-    """The fit check's per-reading terms without a dense whitener (:meth:`fitstats._Linear.per_reading`).
+    """The fit check's per-reading terms without a dense whitener
+    (:meth:`~zerocal_sym.identify.whitened._Linear.per_reading`).
 
     Inputs: whitened residuals ``r`` (n,), whitened data Jacobian ``J``
     (n, p) of full column rank, the banded Cholesky factor ``l`` (n,), ``b``
@@ -162,7 +163,7 @@ def _fit_terms(n: int, p: int):
     aa = ca.vertcat(*[S[j] / l[j] ** 2 for j in range(n)])
     Q = ca.solve(F, G.T)
     den = aa - ca.sum1(G.T * Q).T
-    # the statistics themselves (fitstats._Linear.per_reading): a reading is testable when its mean-shift
+    # the statistics themselves (whitened._Linear.per_reading): a reading is testable when its mean-shift
     # information is not negligible against its own (leverage < 1); NaN where it is not
     ok = den > LEVERAGE_TOL * aa
     nan = ca.SX(np.nan)

@@ -1,7 +1,7 @@
 """Which robot-file entries do the data contradict?  Free each group in turn: a likelihood-ratio test.
 
 The identification holds the robot-file entries outside its set at the
-file's values.  For each group of them (:func:`zerocal_sym.identify.choose.held_groups`:
+file's values.  For each group of them (:func:`zerocal_sym.identify.budget.choose.held_groups`:
 ``L`` for ``L1 L2 L3``) :func:`free_each_group` fits the data again with the
 group identified too (the exact model, Ipopt: :func:`~zerocal_sym.identify.nlls.identify_nlls`)
 and compares the two fits: under the hypothesis that the file is right for
@@ -16,7 +16,7 @@ It tests what the poses can see: a group whose effect the identified
 parameters absorb (a common arm length against a common offset, on a design
 made for the offsets alone) lowers chi² by little whatever its error, and
 the test cannot contradict it (its bias is in the error budget:
-:mod:`zerocal_sym.identify.budget`).  One test per group, each at ``alpha``
+:mod:`zerocal_sym.identify.budget.error_budget`).  One test per group, each at ``alpha``
 (no correction for the number of groups: the result lists them all).
 """
 from __future__ import annotations
@@ -25,16 +25,16 @@ import math
 
 import numpy as np
 
-from zerocal_sym.identify.chi2 import chi2_sf
-from zerocal_sym.identify.choose import held_groups, set_spec
-from zerocal_sym.identify.fitstats import DEFAULT_ALPHA, _fmt_p
+from zerocal_sym.identify.budget.choose import held_groups, set_spec
+from zerocal_sym.identify.check.statistics import DEFAULT_ALPHA
+from zerocal_sym.identify.chi2 import _fmt_p, chi2_sf
 
 #: an entry of a contradicted group is named when the freed fit puts it this many standard deviations from the file
 Z_NAMED = 3.0
 
 
 def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: float = DEFAULT_ALPHA,
-                    held=None, tolerances=None) -> dict:
+                    held=None, tolerances=None, *, identify) -> dict:
     """The likelihood-ratio test of each group of held robot-file entries (module docstring).
 
     Parameters
@@ -48,6 +48,9 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
     tolerances : dict, optional
         name -> tolerance (internal units) of the held entries (default the robot's): how far the freed fit
         puts each entry from the file, in tolerances, ranks the groups that explain the data.
+    identify : callable
+        The exact fit, ``identify(robot, meas, params, noise=, prior=, fit_alpha=) -> IdentificationResult``:
+        :func:`~zerocal_sym.identify.nlls.identify_nlls` (a later stage's, so it is passed in).
 
     Returns
     -------
@@ -61,8 +64,6 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
         whose freed fit passes, the nearest to their tolerances first), ``explained_by`` (the first of them if
         its freed fit passes, else None), ``summary`` (a sentence).
     """
-    from zerocal_sym.identify.nlls import identify_nlls
-
     errors = robot.errors
     tol = robot.tolerances() if tolerances is None else dict(tolerances)
     names = errors.resolve(params)
@@ -70,7 +71,7 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
     K = np.asarray(meas.theta_cmd).shape[0]
     kw = dict(noise=noise, prior=prior, fit_alpha=0.0)
     if held is None:
-        held = identify_nlls(robot, meas, names, **kw)
+        held = identify(robot, meas, names, **kw)
     chi0, rank0 = float(held.info["chi2"]), int(held.info["rank"])
     rows = []
     for g, entries in held_groups(robot, base).items():
@@ -82,7 +83,7 @@ def free_each_group(robot, meas, params="paper", noise=None, prior=None, alpha: 
             row["reason"] = f"{K - 1} readings leave no spare degree of freedom with {g} identified too"
             continue
         try:
-            free = identify_nlls(robot, meas, spec, **kw)
+            free = identify(robot, meas, spec, **kw)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
             row["reason"] = f"the fit with {g} identified failed ({exc})"
             continue

@@ -1,6 +1,6 @@
 """Exact refits without each single reading when the covariance carries the revisits' shared error.
 
-The banded leave-one-out (:func:`zerocal_sym.identify.leave_out.without_each`)
+The banded leave-one-out (:func:`zerocal_sym.identify.diagnose.leave_out.without_each`)
 whitens by bidiagonal factors.  With a pose's systematic error shared by its
 revisits the covariance ``C`` of the changes is the bands plus a low-rank
 part (:mod:`zerocal_sym.identify.covariance`), and the same leave-one-out
@@ -59,8 +59,8 @@ def _refit(exact, j, z):
 
 
 def without_each_shared(exact, z_est=None, select=None) -> dict:
-    """:func:`zerocal_sym.identify.leave_out.without_each`'s result for a round whose covariance has the shared
-    revisit error (``exact``: :class:`~zerocal_sym.identify.exact_refits._Exact`), from its fit reached from
+    """:func:`zerocal_sym.identify.diagnose.leave_out.without_each`'s result for a round whose covariance has the shared
+    revisit error (``exact``: :class:`~zerocal_sym.identify.estimate.exact_model._Exact`), from its fit reached from
     ``z_est`` (else the prior)."""
     n, p = exact.K - 1, exact.p
     rows = exact.prior_rows()

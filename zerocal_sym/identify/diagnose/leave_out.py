@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from zerocal_sym.identify import banded
+from zerocal_sym.identify import banded, fisher
+from zerocal_sym.identify.estimate.nlls_solve import noise_terms
 
 #: the kinematics of a batch of fits is evaluated at about this many poses in one call (fits x K; at least
 #: one fit): the calls have one size (the generated functions mapped over it are cached, their buffers
@@ -43,9 +44,6 @@ class _Round:
     """The data of one round and its exact model, evaluated at N points at once."""
 
     def __init__(self, robot, theta_cmd, readings, names, prior_q, noise, prior_whitener=None):
-        from zerocal_sym.identify import fisher
-        from zerocal_sym.identify.nlls import noise_terms
-
         errors = robot.errors
         self.robot = robot
         self.theta = np.atleast_2d(np.asarray(theta_cmd, float))

@@ -128,12 +128,10 @@ def initial(robot, meas, names, prior_q, warm_start, prior_values):
     if isinstance(warm_start, str):
         if warm_start != "tsvd":
             raise ValueError(f"warm_start must be 'tsvd', None or an array, got {warm_start!r}")
+        from zerocal_sym.identify.estimate.tsvd_round import tsvd_round
+
         try:
-            from zerocal_sym.identify.tsvd import identify_tsvd
-        except ImportError:
-            return x0, "prior (tsvd unavailable)"
-        try:
-            ts = identify_tsvd(robot, meas, prior=prior_q, diagnostics=False)  # the estimate alone
+            ts = tsvd_round(robot, meas, prior=prior_q, diagnostics=False)[0]  # the estimate alone
         except Exception as exc:  # noqa: BLE001 - a failed warm start is not fatal
             return x0, f"prior (tsvd failed: {exc})"
         for k, n in enumerate(names):

@@ -1,6 +1,6 @@
 """The omitted errors' worst-case bias on the exact model, by the estimator itself.
 
-:func:`zerocal_sym.identify.bias.tolerance_bias` bounds the bias to first
+:func:`zerocal_sym.identify.budget.bias.tolerance_bias` bounds the bias to first
 order: ``sum_j |S_ij| t_j``, reached at the corner ``sign(S_i) t`` of the
 tolerance box.  Beyond first order the bias at that corner differs (the
 model is not linear in the omitted errors, nor in the offsets the data show).
@@ -79,13 +79,13 @@ def nlls_estimator(robot, theta_cmd, names, noise, prior):
 
 def tsvd_estimator(robot, theta_cmd, prior=None, t=None, iterations: int = 1):
     """TSVD as an identification ran it (its prior, truncation and iterations) as ``readings -> estimates``."""
-    from zerocal_sym.identify.tsvd import identify_tsvd_many
+    from zerocal_sym.identify.estimate.tsvd_many import tsvd_many
 
     def estimate(R):
         rounds = [Measurements(theta_cmd, r) for r in R]
         priors = [prior] * len(rounds)
         for _ in range(iterations):
-            out = identify_tsvd_many(robot, rounds, priors, t=t)
+            out = tsvd_many(robot, rounds, priors, t=t)
             priors = [None if isinstance(r, Exception) else r.full_vector() for r in out]
         return np.array([np.full(len(robot.errors.resolve("default")), np.nan) if isinstance(r, Exception)
                          else r.estimate for r in out])
@@ -174,13 +174,13 @@ def exact_corner_bias(robot, theta_cmd, S, omitted, tolerances, names, err0, est
 
 def tolerance_bias_exact(robot, theta_cmd, tolerances, params, noise, err0, estimator, operator=None,
                          estimator_name="weighted least squares") -> dict:
-    """:func:`~zerocal_sym.identify.bias.tolerance_bias`, each zero offset's worst case checked on the exact model.
+    """:func:`~zerocal_sym.identify.budget.bias.tolerance_bias`, each zero offset's worst case checked on the exact model.
 
     Adds to ``zero_offsets`` ``worst_case_first_order_<unit>`` (the first-order bound) and
     ``worst_case_exact_<unit>`` (:func:`exact_corner_bias`, by ``estimator``), and reports as
     ``worst_case_<unit>`` (and in ``worst_case``) the larger of the two.
     """
-    from zerocal_sym.identify.bias import bias_sensitivity, tolerance_bias, tolerance_vector
+    from zerocal_sym.identify.budget.bias import bias_sensitivity, tolerance_bias, tolerance_vector
 
     errors = robot.errors
     names = errors.resolve(params)

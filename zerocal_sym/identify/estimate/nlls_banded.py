@@ -1,8 +1,8 @@
 """The nonlinear identification of one round with many poses: numpy and the banded whitening, no K-pose graph.
 
-Up to :data:`~zerocal_sym.identify.nlls_problem.EXPAND_MAX_K` poses a round
+Up to :data:`~zerocal_sym.identify.estimate.nlls_problem.EXPAND_MAX_K` poses a round
 is identified with the CasADi functions of
-:mod:`~zerocal_sym.identify.nlls_problem` (expanded SX, compiled once hot).
+:mod:`~zerocal_sym.identify.estimate.nlls_problem` (expanded SX, compiled once hot).
 Above, a CasADi graph over K poses costs time and memory in proportion to K
 with a large factor (building its derivatives, the work vectors of the
 unrolled Gauss-Newton block); :class:`BandedProblem`
@@ -24,7 +24,7 @@ banded algebra of :mod:`~zerocal_sym.identify.banded`:
 
 Time and memory are linear in K.  :func:`round_problem` picks the one a
 round of K poses is identified with (the Monte Carlo's batches keep
-:func:`~zerocal_sym.identify.nlls_problem.get_problem`).
+:func:`~zerocal_sym.identify.estimate.nlls_problem.get_problem`).
 """
 from __future__ import annotations
 
@@ -34,8 +34,8 @@ from dataclasses import replace
 import numpy as np
 
 from zerocal_sym.identify import banded
-from zerocal_sym.identify import nlls_problem
-from zerocal_sym.identify.nlls_problem import GN_BLOCKS, IPOPT_OPTIONS, N_GN, get_problem
+from zerocal_sym.identify.estimate import nlls_problem
+from zerocal_sym.identify.estimate.nlls_problem import GN_BLOCKS, IPOPT_OPTIONS, N_GN, get_problem
 
 _CACHE: dict = {}
 _LOCK = threading.Lock()
@@ -43,7 +43,7 @@ _LOCK = threading.Lock()
 
 def round_problem(robot, K: int, params="paper"):
     """The problem one round of K poses is identified with: the CasADi functions up to EXPAND_MAX_K poses
-    (:func:`~zerocal_sym.identify.nlls_problem.get_problem`), the banded numpy ones above."""
+    (:func:`~zerocal_sym.identify.estimate.nlls_problem.get_problem`), the banded numpy ones above."""
     if K <= nlls_problem.EXPAND_MAX_K:
         return get_problem(robot, K, params)
     idx = tuple(robot.errors.indices(params))
@@ -57,7 +57,7 @@ def round_problem(robot, K: int, params="paper"):
 
 
 class BandedProblem:
-    """The functions of :class:`~zerocal_sym.identify.nlls_problem.NllsProblem` that one round uses, in numpy.
+    """The functions of :class:`~zerocal_sym.identify.estimate.nlls_problem.NllsProblem` that one round uses, in numpy.
 
     The same parameter vector (:meth:`pack`), the same outputs: ``fast``
     holds ``weights(z, par) -> [l, b]``, ``residuals(z, par, l, b) -> [r,
@@ -87,7 +87,7 @@ class BandedProblem:
         """(Nothing to compile.)"""
 
     def pack(self, theta_cmd, geometry, err_fixed, s, scale, mu, w, sm2, sx2):
-        """The parameter vector, as :meth:`NllsProblem.pack <zerocal_sym.identify.nlls_problem.NllsProblem.pack>`."""
+        """The parameter vector, as :meth:`NllsProblem.pack <zerocal_sym.identify.estimate.nlls_problem.NllsProblem.pack>`."""
         return np.concatenate([np.asarray(theta_cmd, float).ravel(), geometry, err_fixed, s, scale, mu,
                                np.asarray(w, float).ravel(order="F"), [sm2, sx2]])
 
@@ -148,7 +148,7 @@ class BandedProblem:
     def run_gauss_newton(self, z0, par, reweight: bool, tol: float):
         """Damped Gauss-Newton from ``z0`` until the last step is below ``tol`` (at most ``GN_BLOCKS`` x
         ``N_GN`` iterations), as :meth:`NllsProblem.run_gauss_newton
-        <zerocal_sym.identify.nlls_problem.NllsProblem.run_gauss_newton>` (which checks after blocks of
+        <zerocal_sym.identify.estimate.nlls_problem.NllsProblem.run_gauss_newton>` (which checks after blocks of
         ``N_GN``; here every iteration is checked: one evaluation of the kinematics each): ``z, last_step, r,
         r_prior, J, pred, l, b``."""
         z = np.asarray(z0, float).ravel().copy()

@@ -48,8 +48,8 @@ import math
 
 import numpy as np
 
-from zerocal_sym.identify.exact_refits import _Exact
-from zerocal_sym.identify.fitstats import _noise_dict
+from zerocal_sym.identify.estimate.exact_model import _Exact
+from zerocal_sym.identify.result import _noise_dict
 
 #: honest: the bias known well enough that std^2 is known to this fraction of the noise variance
 #: (``sd_b^2 + 2 sd_b |b| <= STD_TOL sigma^2``)
@@ -326,7 +326,7 @@ def _honest_uncertainty(robot, meas, names, prior_eff, noise, est, sol, cov_nois
                        "kind \"total\": std^2 = noise^2 + bias^2, honest where the linearisation bias is small "
                        "and well determined; kind \"bound\": an upper bound, "
                        "std^2 = noise^2 + (|bias| + 2 bias_std + 2 nonlinearity + truncation bound)^2 "
-                       "(zerocal_sym/identify/tsvd_uncertainty.py)")
+                       "(zerocal_sym/identify/estimate/tsvd_uncertainty.py)")
     return out
 
 

@@ -12,7 +12,7 @@ file's value.  Its error has two parts, reported per zero offset ``i``:
     the largest bias the entries held at the file's values can put on it
     when each is off by up to its tolerance (first order, worst case):
     ``sum_j |S_ij| t_j``, with ``S = d(estimate) / d(held entries)`` the
-    estimator's bias sensitivity (:mod:`zerocal_sym.identify.bias`, e.g.
+    estimator's bias sensitivity (:mod:`zerocal_sym.identify.budget.bias`, e.g.
     deg/mm) and ``t_j`` the entry's tolerance (the robot file's
     ``[tolerances]``, :mod:`zerocal_sym.model.tolerances`; ``--tolerance``
     overrides).  It does not shrink with more poses of the same design: no
@@ -50,7 +50,7 @@ def error_budget(bias: dict, result) -> dict:
     Parameters
     ----------
     bias : dict
-        :func:`zerocal_sym.identify.bias.tolerance_bias` of the result's
+        :func:`zerocal_sym.identify.budget.bias.tolerance_bias` of the result's
         estimator (its ``sensitivity`` in user units per user unit and the
         ``tolerances`` of the entries held).
     result : IdentificationResult
@@ -76,7 +76,7 @@ def error_budget(bias: dict, result) -> dict:
     unit = errors.offset_user_unit
     std = np.asarray(result.std_zero_offsets_user, float)
     # the bound reported for each offset: the larger of the first-order bound and the exact model's at its worst
-    # corner, when the exact search ran (zerocal_sym.identify.bias_exact); its split by entry is first-order's
+    # corner, when the exact search ran (zerocal_sym.identify.budget.bias_exact); its split by entry is first-order's
     zo = bias.get("zero_offsets") or {}
     worst = dict(zip(zo.get("names", ()), zo.get(f"worst_case_{unit}", ()))) if "names" in zo else {}
     out = []

@@ -3,7 +3,7 @@
 Identifying more of the robot (an arm length with the zero offsets) trades
 bias for variance: an entry held at the robot file's value can bias the
 offsets by up to its tolerance times their sensitivity to it
-(:mod:`zerocal_sym.identify.bias`); an entry identified costs variance,
+(:mod:`zerocal_sym.identify.budget.bias`); an entry identified costs variance,
 because the data must now tell it from the offsets.  For a parameter set
 ``S`` and poses ``theta_cmd`` the expected squared error of zero offset ``i``
 is (first order, the held entries independent and uniform within their
@@ -26,8 +26,8 @@ import math
 import numpy as np
 
 from zerocal_sym.errors import PoseError
-from zerocal_sym.identify import bias as bias_mod
 from zerocal_sym.identify import fisher
+from zerocal_sym.identify.budget import bias as bias_mod
 from zerocal_sym.model import tolerances as tl
 from zerocal_sym.model import units
 
