@@ -4,7 +4,7 @@ Every command runs in a fresh process, the commands interleaved (each pass runs 
 rotating: benchmarks/_harness.py); wall time and the child's CPU time (user + system), medians over the
 passes, and the ratio to the baseline in the same pass; the load average printed.
 
-Target (issue 2): `zerocal --help` answers in under a second (of CPU: the wall time is the load's).
+Target: `zerocal --help` answers in under a second (of CPU: the wall time is the load's).
 Usage: python benchmarks/bench_cli.py [--repeat N] [--json]
 """
 import argparse

@@ -188,9 +188,9 @@ def main():
     ap.add_argument("--K", type=int, nargs="+", default=[6, 20])
     ap.add_argument("--criteria", nargs="+", default=["crlb", "cond"])
     ap.add_argument("--starts", type=int, default=8)
-    ap.add_argument("--only-extras", "--only-issue13", dest="only_extras", action="store_true",
+    ap.add_argument("--only-extras", dest="only_extras", action="store_true",
                     help="only the reachable case and the extra cases")
-    ap.add_argument("--no-extras", "--no-issue13", dest="no_extras", action="store_true",
+    ap.add_argument("--no-extras", dest="no_extras", action="store_true",
                     help="skip the extra cases (K = 100, fewest poses)")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     a = ap.parse_args()

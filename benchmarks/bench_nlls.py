@@ -22,7 +22,7 @@ an order that rotates from pass to pass), CPU time (this process) beside wall ti
 
 and the ratios (scipy's CPU time over ours in the same pass, median over the passes; > 1: ours is faster):
 
-  x lm           scipy-lm / identify       (the issue's "speedup")
+  x lm           scipy-lm / identify       (the "speedup" asked for)
   x zc           scipy-zc / identify
   int x lm       scipy-lm / identify-int
   x zc-c         scipy-zc-c / identify

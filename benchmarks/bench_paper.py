@@ -12,7 +12,7 @@ The columns of each comparison are timed interleaved (benchmarks/_harness.py), C
 or the child's for a command) beside wall time, the ratios from the CPU times of the same pass; the load
 average printed.
 
-Target (issue 3): ``zerocal reproduce`` finishes well under a minute.
+Target: ``zerocal reproduce`` finishes well under a minute.
 Usage: python benchmarks/bench_paper.py [--repeat N] [--json]
 """
 import argparse

@@ -1,4 +1,4 @@
-"""Monte Carlo: mean squared error of the bias-aware (mse) designs against the CRLB-only design (issue 13).
+"""Monte Carlo: mean squared error of the bias-aware (mse) designs against the CRLB-only design .
 
 The paper's robot, K poses, paper noise.  For each tolerance scale s (default 1 and 10): the CRLB-only design
 (criterion crlb, which ignores the omitted errors) and the bias-aware designs (criterion mse with the

@@ -1,10 +1,9 @@
-"""Reproduce the numbers shared/DELTA.md reports for the default Delta robot, and check them.
+"""Reproduce the reference values docs/delta.md gives for the default rotary Delta robot, and check them.
 
-Run:  python examples/delta_numbers.py        (prints each number beside DELTA.md's; exit 1 on a mismatch)
+Run:  python examples/delta_numbers.py        (prints each number beside the reference; exit 1 on a mismatch)
 
-Every number is computed here with zerocal_sym (an implementation independent
-of the one DELTA.md's numbers came from); the tolerance of each check is the
-number of digits DELTA.md prints.
+The reference values came from an implementation of the model independent of zerocal_sym; every number is
+computed here with zerocal_sym, and the tolerance of each check is the number of digits the reference gives.
 """
 import sys
 from pathlib import Path
@@ -26,7 +25,7 @@ failures = []
 
 
 def report(ok, what, ours, theirs):
-    print(f"{'ok ' if ok else 'BAD'} {what}: ours {ours}  DELTA.md {theirs}")
+    print(f"{'ok ' if ok else 'BAD'} {what}: ours {ours}  reference {theirs}")
     if not ok:
         failures.append(what)
 

@@ -5,7 +5,7 @@ A simulated measurement round of the paper's robot (Table 1): Table 2 group 1
 in the paper's frame as ``zerocal simulate`` does -- ours mirrored about the
 x axis, so the true offsets in the robot's frame are (-2, +1) deg and the
 MAEMM (1, -0.5) mm; see ``zerocal_sym/paper/tables.py``), the paper's six poses
-(``scheme.paper_poses(robot, 3)``, visiting order as in SPEC.md), the paper's
+(``scheme.paper_poses(robot, 3)``, visiting order as in ``docs/model.md``), the paper's
 noise (Eqs. 34-35) and the random stream ``default_rng([2017, 1])``.  The
 readings are the same as those of
 ``zerocal simulate --group 1 --seed 2017 --noise paper --n 3`` (only the

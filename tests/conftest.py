@@ -41,6 +41,16 @@ def pytest_configure(config):
 
 
 @pytest.fixture(scope="session")
+def docs_runs(tmp_path_factory):
+    """The docs checker's runs (tests/docs_check.py), once per session across pytest-xdist workers: a directory
+    shared by the workers (their base directories' parent)."""
+    import docs_check
+
+    base = tmp_path_factory.getbasetemp()
+    return docs_check.SharedCache((base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "docs-check")
+
+
+@pytest.fixture(scope="session")
 def robot():
     from zerocal_sym.model.robot import paper_robot
 

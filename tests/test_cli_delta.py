@@ -1,4 +1,4 @@
-"""Every command on the rotary Delta (examples/delta.toml, DELTA.md) through ``--robot``."""
+"""Every command on the rotary Delta (examples/delta.toml, docs/delta.md) through ``--robot``."""
 import json
 import os
 import shutil
@@ -57,7 +57,7 @@ def test_robot_json(capsys):
     assert s["mechanism"] == "delta_rotary" and s["workspace"] == "cylinder"
     np.testing.assert_allclose(s["home_pose_mm"], [0.0, 0.0, -624.500], atol=5e-4)
     lo, hi = s["joint_range_deg"]
-    assert lo == pytest.approx(-7.003, abs=1e-3) and hi == pytest.approx(59.13, abs=0.01)  # DELTA.md
+    assert lo == pytest.approx(-7.003, abs=1e-3) and hi == pytest.approx(59.13, abs=0.01)  # reference values
     assert s["fk_ik_max_error_mm"] < 1e-9
     assert s["joint_names"] == ["theta1", "theta2", "theta3"] and s["pose_names"] == ["x", "y", "z"]
     assert all(len(c["pose_mm"]) == 3 and len(c["joints_deg"]) == 3 for c in s["corners"].values())
@@ -76,9 +76,9 @@ def test_design_ring_json(capsys):
     np.testing.assert_allclose(P[0], [200, 0, -700], atol=1e-9)
     np.testing.assert_allclose(P[6], [200, 0, -900], atol=1e-9)
     np.testing.assert_allclose(np.hypot(P[:, 0], P[:, 1]), 200.0)
-    assert d["kappa_1"] == pytest.approx(233.4, abs=0.05)  # DELTA.md: cond(G) = 233.4
+    assert d["kappa_1"] == pytest.approx(233.4, abs=0.05)  # reference: cond(G) = 233.4
     assert len(d["crlb_zero_offsets_deg"]) == 3
-    np.testing.assert_allclose(d["crlb_zero_offsets_deg"], 0.382, atol=0.001)  # DELTA.md, paper noise
+    np.testing.assert_allclose(d["crlb_zero_offsets_deg"], 0.382, atol=0.001)  # reference, paper noise
     assert 0.0263 <= min(d["crlb_zero_offsets_deg_scale_only"]) <= max(d["crlb_zero_offsets_deg_scale_only"]) <= 0.0275
 
 
@@ -87,7 +87,7 @@ def test_design_default_scheme_and_table(capsys):
     assert d["scheme"] == "ring" and d["n"] == 6 and d["selected_by"].startswith("default")
     table = {row["n"]: row for row in d["n_table"]}
     assert min(table) == 4  # 2n - 1 >= 6 parameters
-    assert table[4]["kappa_1"] == pytest.approx(3186, abs=1)  # DELTA.md: badly conditioned at n = 4
+    assert table[4]["kappa_1"] == pytest.approx(3186, abs=1)  # reference: badly conditioned at n = 4
     out = zc(capsys, "design", *R, "--maemm-prior", "1", "0.5", "-0.5")
     assert "kappa_1 = 233.433" in out and "with the MAEMM prior" in out and "P12" in out
 
@@ -130,7 +130,7 @@ def test_simulate_identify_recovers_offsets(capsys, ring6, tmp_path, method):
     if method == "nlls":  # the exact model: noise-free data give the truth
         np.testing.assert_allclose(res["zero_offsets_deg"], [2.0, -1.0, 0.5], atol=1e-6)
         np.testing.assert_allclose(res["maemm_mm"], 0.0, atol=1e-6)
-    else:  # one linear step at zero errors: off by ~0.1 deg at n = 6 (DELTA.md: 0.12 deg with a MAEMM too)
+    else:  # one linear step at zero errors: off by ~0.1 deg at n = 6 (reference: 0.12 deg with a MAEMM too)
         err = np.abs(np.array(res["zero_offsets_deg"]) - [2.0, -1.0, 0.5])
         assert 0.01 < np.max(err) < 0.2, err
     assert json.loads(out.read_text()) == res

@@ -108,7 +108,7 @@ def test_prior_and_bound_options(csv_file, capsys):
     rc, d, _ = run_json(capsys, ["identify", str(path), "--bound", "theta1=-0.5:0.5", "--prior-std", "rMx=0.001",
                                  "--accept-misfit", "--json"])
     assert abs(d["zero_offsets_deg"][0]) <= 0.5 + 1e-6 and abs(d["maemm_mm"][0]) < 0.01
-    # the bound holds theta1 at 0.5 deg where the data say 3.06 +- 0.44 deg: the fit check rejects it (issue 11),
+    # the bound holds theta1 at 0.5 deg where the data say 3.06 +- 0.44 deg: the fit check rejects it,
     # naming the bound; --accept-misfit keeps it, and the result records the override
     assert rc == 0 and d["success"] and d["status"].startswith("accepted despite misfit")
     assert "bound on theta1" in d["status"] or "bound on theta1" in d["fit"]["diagnosis"]

@@ -1,4 +1,4 @@
-"""Calibrations a user can trust (issue 11), through the CLI as the user meets it."""
+"""Calibrations a user can trust , through the CLI as the user meets it."""
 import json
 from pathlib import Path
 
@@ -186,7 +186,7 @@ def test_verdict_judges_sigma_against_the_largest_offset_or_the_goal(capsys, tmp
 
 
 def test_identify_reports_the_bias_from_the_omitted_errors(capsys, tmp_path):
-    """issue 13: identify states the bias its estimate may carry from the errors left out, within their tolerances."""
+    """identify states the bias its estimate may carry from the errors left out, within their tolerances."""
     data = simulate(capsys, tmp_path / "d.csv", "--noise", "scale-only")
     rc, out, err = zc(capsys, "identify", data, "--json", "--accept-misfit")
     assert rc == 0, err

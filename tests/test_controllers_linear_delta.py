@@ -425,11 +425,14 @@ def test_cli_output_over_the_input_refused(capsys, identified):
 def test_the_documented_examples_read_back(tmp_path):
     """docs/data-format.md's pasted exports: each corrected value is the current one plus its tower's offset comment,
     and the file's towers are the robot file's by azimuth (a = s2, b = s3, c = s1)."""
-    doc = (ROOT / "docs" / "data-format.md").read_text()
-    section = doc.split("## Controller exports", 1)[1].split("\n## ", 1)[0]
-    blocks = re.findall(r"```\n(.*?)```", section, flags=re.S)
-    klipper = next(b for b in blocks if "[stepper_a]" in b)
-    rrf = next(b for b in blocks if b.startswith("; zerocal"))
+    import docs_check  # the page's console blocks: each command with the output the page shows (the docs checker)
+
+    page = docs_check.parse_page(ROOT / "docs" / "data-format.md")
+    shown = {c.text: "\n".join(c.expected) + "\n" for it in page.items if it.kind == "block" for c in it.commands
+             if c.expected}
+    klipper = next(out for cmd, out in shown.items() if "--format klipper" in cmd)
+    rrf = next(out for cmd, out in shown.items() if "--format rrf" in cmd)
+    assert "[stepper_a]" in klipper and rrf.startswith("; zerocal")
     sec, _ = parse_klipper(klipper)
     offsets = {m.group(1): float(m.group(2)) for m in re.finditer(r"# tower (s\d): offset_mm (\S+)", klipper)}
     for name, joint in zip("abc", ("s2", "s3", "s1")):

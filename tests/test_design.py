@@ -184,7 +184,7 @@ def test_constraint_travel_range(robot):
     res = _fast(robot, cons)
     rho = kin.measuring_vector(robot, res.poses)[0]
     assert np.ptp(rho) <= 100.0 + 1e-6
-    # the paper's scheme spans 192.8 mm: it is no baseline (issue 13), the note and the rejection say why
+    # the paper's scheme spans 192.8 mm: it is no baseline, the note and the rejection say why
     assert res.paper is None and "scale travel" in res.baseline_note
     assert any("scale travel" in v for v in res.baseline_rejected[0]["violations"])
     assert res.to_dict()["ratio"]["crlb_rms_design_over_paper"] is None
@@ -218,7 +218,7 @@ def test_constraint_joint_limits(robot):
     assert np.all(deg[:, 0] >= -10 - 1e-6) and np.all(deg[:, 0] <= 30 + 1e-6)
     assert np.all(deg[:, 1] >= 150 - 1e-6) and np.all(deg[:, 1] <= 200 + 1e-6)
     assert design.check_design(robot, res.poses, cons) == []
-    assert res.paper is None and "outside [150, 200]" in res.baseline_note  # no baseline (issue 13)
+    assert res.paper is None and "outside [150, 200]" in res.baseline_note  # no baseline
     assert any("theta1" in v for v in res.baseline_rejected[0]["violations"])  # its corners need theta1 up to 38 deg
 
 

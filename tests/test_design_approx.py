@@ -1,4 +1,4 @@
-"""Issue 13: approximate designs with certificates, reachable regions, bias-aware and position criteria.
+"""Approximate designs with certificates, reachable regions, bias-aware and position criteria.
 
 No timing asserts (benchmarks/bench_design.py prints the times).
 """

@@ -1,6 +1,6 @@
 """Measurement-pose design on the rotary Delta (n = 3 pose coordinates, m = 3 joints, cylinder workspace).
 
-Numbers from DELTA.md (independent implementation): ring scheme cond(G) = 3186
+Reference values from an independent implementation (docs/delta.md): ring scheme cond(G) = 3186
 at n = 4 (K = 8) and 233.4 at n = 6 (K = 12); CRLB of each zero offset
 0.0264-0.0274 deg with the scale error alone and 0.382 deg with the servo
 error too (n = 6).
@@ -86,11 +86,11 @@ def test_ring_scheme_baseline_k12(delta, dcons):
     print(f"ring scheme n = 6: kappa {kappa:.4f}, CRLB {rep['crlb_zero_offsets_deg']} deg")
     assert rep["kappa"] == pytest.approx(kappa, rel=1e-12)
     assert rep["criterion"]["values"]["cond"] == pytest.approx(kappa, rel=1e-9)
-    assert kappa == pytest.approx(233.4, rel=1e-3)  # DELTA.md
+    assert kappa == pytest.approx(233.4, rel=1e-3)  # the reference value
     assert rep["violations"] == []
-    np.testing.assert_allclose(rep["crlb_zero_offsets_deg"], 0.382, atol=5e-4)  # DELTA.md, servo error too
+    np.testing.assert_allclose(rep["crlb_zero_offsets_deg"], 0.382, atol=5e-4)  # the reference value, servo error too
     scale = design.evaluate(delta, P, "crlb", NoiseModel.paper(servo=0.0))["crlb_zero_offsets_deg"]
-    assert 0.0263 < min(scale) and max(scale) < 0.0275  # DELTA.md 0.0264-0.0274 deg
+    assert 0.0263 < min(scale) and max(scale) < 0.0275  # reference 0.0264-0.0274 deg
     assert rep["crlb_rms_deg"] == pytest.approx(rep["criterion"]["values"]["crlb"], rel=1e-9)
     assert rep["criterion"]["units_all"]["D"] == "log(1/mm^12)"
 
@@ -99,7 +99,7 @@ def test_ring_scheme_baseline_k8(delta, dcons):
     P = design.paper_baseline(delta, 8)
     _assert_feasible(delta, dcons, P)
     kappa = design.criterion_values(delta, P, NOISE)["cond"]
-    assert kappa == pytest.approx(3186, rel=1e-3)  # DELTA.md: badly conditioned with c on the axis
+    assert kappa == pytest.approx(3186, rel=1e-3)  # the reference value: badly conditioned with c on the axis
 
 
 def test_odd_k_and_region_baseline(delta):
@@ -220,7 +220,7 @@ def test_constraint_cylinder_region_and_joint_limits(delta):
     assert np.all(deg >= -5 - 1e-6) and np.all(deg <= 40 + 1e-6)
     assert design.check_design(delta, P, cons) == []
     # the ring rule on the region's circles is tried first; it (and the workspace's ring) break the joint
-    # limits, so there is no baseline (issue 13: a baseline is feasible or left out with a note)
+    # limits, so there is no baseline (a baseline is feasible or left out with a note)
     assert res.paper is None and "joint" not in res.baseline_note or "outside [-5, 40]" in res.baseline_note
     Pp = np.array(res.baseline_rejected[0]["poses"])
     np.testing.assert_allclose(np.hypot(Pp[:, 0], Pp[:, 1]), 150)
@@ -233,7 +233,7 @@ def test_constraint_travel_and_separation(delta):
     assert np.ptp(rho) <= 120.0 + 1e-6
     d = np.linalg.norm(res.poses[:, None] - res.poses[None], axis=2)
     assert d[np.triu_indices(8, 1)].min() >= 60.0 - 1e-6
-    # the ring scheme spans 191 mm: no baseline (issue 13), the rejected scheme's violations say why
+    # the ring scheme spans 191 mm: no baseline, the rejected scheme's violations say why
     assert res.paper is None and "scale travel" in res.baseline_note
     assert any("scale travel" in v for v in res.baseline_rejected[0]["violations"])
 

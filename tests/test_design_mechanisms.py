@@ -1,6 +1,6 @@
 """``zerocal design`` on the linear Delta (prismatic joints, mm) and the hexapod (6-D poses, the corner scheme).
 
-The numbers are those of the shared model pages (the linear Delta's ring table, the hexapod's corner scheme),
+The numbers are those of the model pages (the linear Delta's ring table, the hexapod's corner scheme),
 compared at the digits the page gives them with; the keys carry the joints' unit; the boundary scheme's K comes
 from the workspace (2n on a cylinder, n on a box); ``--optimize`` on both robots.
 """

@@ -1,4 +1,4 @@
-"""Calibrations a user can trust (issue 11), at library level: the fit check, outliers, the honest TSVD
+"""Calibrations a user can trust , at library level: the fit check, outliers, the honest TSVD
 std and plausibility, for every mechanism -- each case measured as a user meets it."""
 import json
 import math
@@ -135,7 +135,7 @@ def test_wrong_robot_file_is_rejected(case, tmp_path):
         assert not res.success and res.status.startswith("rejected"), res.status
         fit = res.info["fit"]
         assert fit["p_value"] < 1e-20 and "robot file" in fit["diagnosis"]
-        if case.robot.mechanism_name == "planar_2dof":  # the issue: chi² ~ 1000 on 1 dof (1027 there)
+        if case.robot.mechanism_name == "planar_2dof":  # the reported case: chi² ~ 1000 on 1 dof (1027 there)
             assert fit["dof"] == 1 and fit["chi2"] > 500
     # with the right file the same data pass
     assert identify_nlls(case.robot, m, noise=PAPER).success
@@ -157,7 +157,7 @@ def test_accept_misfit_and_fit_alpha(case, tmp_path):
 
 # ------------------------------------------------------------------ one bad reading
 def test_one_bad_reading_is_rejected_and_named(case):
-    """0.9 mm on the reading at pose 5, scale error only (the issue's case), K = 12."""
+    """0.9 mm on the reading at pose 5, scale error only (the reported case), K = 12."""
     m = case.meas(case.th_large, SCALE, seed=2, bad=(5, 0.9))
     for res in (identify_nlls(case.robot, m, noise=SCALE), identify_tsvd(case.robot, m, noise=SCALE)):
         # rejected -- or, for the Delta's l2 fit, not converged (the outlier drags it along a weak direction):

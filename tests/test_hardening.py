@@ -1,11 +1,11 @@
-"""Calibrations a user can trust (issue 11, the hardening half), met as a user meets them.
+"""Calibrations a user can trust (the hardening half), met as a user meets them.
 
 The command line on real files in ``tmp_path``: the exit status, the one
 line on stderr, what is (not) written.  Files: an output that is an input is
 refused and the input untouched; modes follow the umask; a symlink is
 written through; devices and FIFOs are streams; a failed command leaves no
 partial plot directory; messages name the user's paths; an empty name is an
-error; a closed pipe ends quietly.  Every traceback found (the brief's and a
+error; a closed pipe ends quietly.  Every traceback found (the reported ones and a
 fuzz over every command's options) is one line and exit 2; an option that
 does not apply to the chosen mode is an error; a template identify would
 refuse is refused; Ctrl-C ends a long command within a second or two with

@@ -297,7 +297,7 @@ def test_study_chunk_read_refuses_an_npy(tmp_path):
         study_chunks.read_chunk(p, "c", "d", ["theta1"], 0, 3)
 
 
-# --------------------------------------------------------------------------- the new-user review (issues 1-7)
+# --------------------------------------------------------------------------- the new-user review
 
 def test_bogus_compile_mode_writes_nothing(tmp_path, capsys, monkeypatch):
     monkeypatch.setenv("ZEROCAL_COMPILE", "bogus")

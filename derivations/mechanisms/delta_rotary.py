@@ -1,4 +1,4 @@
-"""The rotary Delta robot with a spherical-joint measuring mechanism (``shared/DELTA.md``).
+"""The rotary Delta robot with a spherical-joint measuring mechanism (``docs/delta.md``).
 
 Frame: origin O at the centre of the plane of the shoulder axes, z up, the
 workspace below the base (z < 0).  Limb i at azimuth ``phi_i`` with

@@ -1,6 +1,6 @@
 """The 2-DOF translational parallel robot of Mei et al. (2017), derived in sympy.
 
-Frame (SPEC.md): origin O at the base centre, x from A2 towards A1, y from the
+Frame (``docs/model.md``): origin O at the base centre, x from A2 towards A1, y from the
 base towards the workspace.  Limb i: ``B_i = A_i + L_i u_i`` with
 ``u_i = (cos th_i, sin th_i)``; ``P = B_i + l_i w_i``, ``|w_i| = 1``.
 

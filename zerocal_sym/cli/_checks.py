@@ -151,7 +151,7 @@ def identifiability_problem(robot, theta_cmd, names, err0=None, poses=None):
 # --------------------------------------------------------------------------- per command
 
 def _trust(args) -> None:
-    """identify / verify: the fit check's and plausibility's options (issue 11)."""
+    """identify / verify: the fit check's and plausibility's options."""
     if args.method == "tsvd":
         bad = _given(args, "loss", "loss_scale")
         if bad:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 #: The scheme parameter n when ``--n`` is not given, by scheme: the paper's n = 3
-#: (its eps rule's choice, Section 5); the ring scheme's n = 6 (DELTA.md: n = 4
+#: (its eps rule's choice, Section 5); the ring scheme's n = 6 (``docs/delta.md``: n = 4
 #: is the fewest that identify the Delta's 6 parameters, but cond(G) = 3186
 #: there; 233 at n = 6); the corner scheme's n = 64 (every corner of the box).
 #: A scheme not listed: the fewest that identify.

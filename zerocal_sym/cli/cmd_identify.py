@@ -101,7 +101,7 @@ def add_arguments(p):
 
 
 def add_trust_arguments(p, nlls_default=True):
-    """The fit-check and plausibility options (issue 11), shared by identify and verify."""
+    """The fit-check and plausibility options, shared by identify and verify."""
     p.add_argument("--fit-alpha", type=float, default=0.001, metavar="ALPHA",
                    help="significance level of the fit check: reject the fit when its chi2 p-value < ALPHA "
                         "(default 0.001)")

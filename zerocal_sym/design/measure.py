@@ -1,4 +1,4 @@
-"""The optimal design measure on a set of candidate poses, and its certificate (issue 13).
+"""The optimal design measure on a set of candidate poses, and its certificate.
 
 The criteria, their directional derivatives ``d(x)`` and the efficiency
 bounds are those of the order-free pose model

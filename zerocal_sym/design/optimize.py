@@ -19,7 +19,7 @@ mechanism allow.  Two methods, each a check on the other:
 design (exhaustively for K <= 8, by pair swaps and segment reversals
 otherwise), polishes it with Ipopt and returns it with the workspace's
 boundary scheme at the same K as the baseline: the paper's scheme on a
-rectangle, the ring scheme (``DELTA.md``) on a cylinder.  (The
+rectangle, the ring scheme (``docs/delta.md``) on a cylinder.  (The
 result keeps the name ``paper`` for the baseline's report.)
 
 Everything is generic over the mechanism: poses (K, n), joints (K, m), the

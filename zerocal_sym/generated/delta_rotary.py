@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/delta_rotary.py
-inputs hash: 91caec1dd74dbdcc
+inputs hash: 5f39c70e19cfaf00
 sympy: 1.14.0
 """
 import casadi as ca

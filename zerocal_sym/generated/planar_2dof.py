@@ -2,7 +2,7 @@
 
 GENERATED -- DO NOT EDIT.  Regenerate with ``zerocal regen``.
 source: derivations/codegen.py, derivations/geometry.py, derivations/mechanism.py, derivations/mechanisms/planar_2dof.py
-inputs hash: 3fdd91c664b358a1
+inputs hash: 5f5101e89615e807
 sympy: 1.14.0
 """
 import casadi as ca

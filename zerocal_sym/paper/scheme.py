@@ -3,7 +3,7 @@
 ``n`` evenly spaced poses on the boundary ``y = H`` from ``x = -b/2`` to
 ``+b/2``, then ``n`` on ``y = H + h``, again from ``-b/2`` to ``+b/2``
 (``K = 2n``).  This order reproduces the paper's ``kappa_1 = 475.34`` at
-``n = 3`` (SPEC.md); the order matters because G differences consecutive rows.
+``n = 3`` (``docs/model.md``); the order matters because G differences consecutive rows.
 It is the rectangle's boundary scheme
 (:meth:`zerocal_sym.model.workspace.Rectangle.boundary_scheme`); the paper's
 identification matrix G is :func:`zerocal_sym.identify.linear.identification_matrix`.
