@@ -198,3 +198,28 @@ def test_one_spare_degree_of_freedom_max_test_adds_nothing():
         assert abs(r["standardised"]) == pytest.approx(math.sqrt(fit["chi2"]), rel=tol)
     assert fit["max_reading"]["p_value"] >= fit["p_value"] == pytest.approx(chi2_sf(fit["chi2"], 1))
     assert res.info["fit"]["max_reading"]["p_value"] >= res.info["fit"]["p_value"]
+
+
+def test_the_report_and_the_verdict_line_say_which_test():
+    """A results file's fit record with the second test's rejection (kept by --accept-misfit): the report reads it
+    (a wrong type is an error naming the key), its fit-check section and the verdict line name the reading."""
+    from types import SimpleNamespace
+
+    from zerocal_sym.cli._identify_text import accepted_why
+    from zerocal_sym.errors import DataFileError
+    from zerocal_sym.report.contents import fit_record
+    from zerocal_sym.report.html import _fit
+
+    fit = {"chi2": 1302.2, "dof": 1995, "p_value": 1.0, "alpha": 1e-3, "checked": True, "rejected": True,
+           "chi2_rejected": False, "accepted_despite_misfit": True, "diagnosis": "The noise model rejects this fit.",
+           "max_reading": {"pose": 700, "from_pose": 699, "standardised": 32.94, "readings": 1999,
+                           "p_value": 1.06e-234, "rejected": True}}
+    rec = fit_record(SimpleNamespace(raw={"fit": fit}, source="r.json"))
+    assert rec["max_reading"] == {"pose": 700.0, "standardised": 32.94, "readings": 1999.0, "p_value": 1.06e-234,
+                                  "rejected": True}
+    html = _fit({"fit": rec}, None)
+    assert 'id="max-reading"' in html and "pose 700</strong>" in html and "1999" in html
+    assert accepted_why(rec, 1e-3) == ("accepted despite misfit (--accept-misfit; the largest standardised "
+                                       "residual's p-value 1.06e-234 < 0.001, at pose 700)")
+    with pytest.raises(DataFileError, match="max_reading"):
+        fit_record(SimpleNamespace(raw={"fit": {**fit, "max_reading": [700]}}, source="r.json"))
