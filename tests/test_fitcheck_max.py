@@ -223,3 +223,20 @@ def test_the_report_and_the_verdict_line_say_which_test():
                                        "residual's p-value 1.06e-234 < 0.001, at pose 700)")
     with pytest.raises(DataFileError, match="max_reading"):
         fit_record(SimpleNamespace(raw={"fit": {**fit, "max_reading": [700]}}, source="r.json"))
+
+
+def test_with_the_revisits_shared_error():
+    """The poses visited twice with a shared revisit error in the noise model (the full covariance, not the bands):
+    the same refusal, naming the reading, its error from the exact refit without it, both methods."""
+    rnd = _round("planar_2dof")
+    theta = np.concatenate([rnd.theta, rnd.theta])
+    noise = NoiseModel(rnd.noise.sigma_scale_mm, rnd.noise.sigma_joint, 0.002)
+    rd = VirtualPlant(rnd.robot, rnd.truth).measure(theta, noise, np.random.default_rng(2))
+    rd[37] += 0.15
+    m = Measurements(theta, rd)
+    for res in (identify_nlls(rnd.robot, m, noise=noise.scaled(3, 3, 3)),
+                identify_tsvd(rnd.robot, m, noise=noise.scaled(3, 3, 3))):
+        fit = res.info["fit"]
+        assert not res.success and not fit["chi2_rejected"] and fit["max_reading"]["pose"] == 37, res.status
+        # (the stated noise puts ~0.015 mm on the estimated error: t ~ 10 for 0.15 mm; 0.03 mm is 2 of it)
+        assert fit["causes"][0]["pose"] == 37 and fit["causes"][0]["estimated_error_mm"] == pytest.approx(0.15, abs=0.03)
