@@ -201,3 +201,45 @@ def test_identify_reports_the_bias_from_the_omitted_errors(capsys, tmp_path):
     assert all(w >= f for w, f in zip(b10["worst_case_deg"], b10["worst_case_first_order_deg"]))
     rc, out, err = zc(capsys, "identify", data, "--tolerance", "nope=1")
     assert rc == 2 and "nope" in err and len(err.strip().splitlines()) == 1
+
+
+def test_one_gross_reading_among_many_is_refused(capsys, tmp_path):
+    """One reading 0.5 mm off among K = 2000, identified with a robot file whose [noise] states 3 x the paper's
+    noise: the chi² passes (the overstated noise hides it), the largest standardised residual refuses the fit
+    and names the reading -- its pose, the change from the pose before, its estimated error."""
+    import numpy as np
+
+    from zerocal_sym.model.robot import paper_robot
+
+    robot = paper_robot()
+    lo, hi = robot.workspace.bounds()
+    P = lo + (hi - lo) * np.random.default_rng(3).random((6000, 2))
+    P = P[robot.workspace.contains(P, -1.0)][:2000]
+    assert P.shape == (2000, 2)
+    poses = tmp_path / "poses.csv"
+    poses.write_text("x_mm,y_mm\n" + "".join(f"{x!r},{y!r}\n" for x, y in P.tolist()))
+    data = tmp_path / "d.csv"
+    rc, _, err = zc(capsys, "simulate", "--poses", poses, "--set", "theta1=0.5", "--set", "theta2=-0.3",
+                    "--seed", 4, "--out", data)
+    assert rc == 0, err
+    drop_sha(data)
+    edit_reading(data, 700, 0.5)
+    noisy = tmp_path / "noisy.toml"  # the paper's noise (1.117 um per change, 0.0024 deg per joint) x 3
+    noisy.write_text((ROOT / "examples" / "paper_robot.toml").read_text()
+                     + "\n[noise]\nscale = 0.00335\njoint = 0.0072\n")
+    out = tmp_path / "r.json"
+    rc, o, err = zc(capsys, "identify", data, "--robot", noisy, "--out", out)
+    assert rc == 1 and not out.exists(), (o, err)
+    assert ("rejected: the noise model rejects the fit (one reading: standardised residual" in err
+            and "the largest of 1999" in err and "passes; likely: the reading at pose 700 (the change from pose 699 "
+            "to pose 700) is off by about +0.4" in err), err
+    rc, o, err = zc(capsys, "identify", data, "--robot", noisy, "--out", out, "--accept-misfit")
+    assert rc == 0, err
+    fit = json.loads(out.read_text())["fit"]
+    print(f"chi2 {fit['chi2']:.6g} on {fit['dof']} dof, p = {fit['p_value']:.3g}; largest standardised residual "
+          f"{fit['max_reading']['standardised']:.4g} at pose {fit['max_reading']['pose']}, "
+          f"p = {fit['max_reading']['p_value']:.3g}; its estimated error {fit['causes'][0]['estimated_error_mm']:+.3g} mm")
+    assert fit["p_value"] >= fit["alpha"] and not fit["chi2_rejected"]
+    assert fit["max_reading"]["pose"] == 700 and fit["max_reading"]["p_value"] < fit["alpha"]
+    assert fit["causes"][0]["pose"] == 700 and abs(fit["causes"][0]["estimated_error_mm"] - 0.5) < 0.05
+    assert "largest standardised residual's p-value" in o and "at pose 700" in o

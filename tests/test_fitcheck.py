@@ -403,8 +403,11 @@ def test_plausibility(robot, tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("mech, n", [("planar_2dof", 3), ("planar_2dof", 6), ("delta_rotary", 6)])
 def test_false_rejection_rate_is_the_nominal_level(mech, n):
-    """4000 clean rounds (paper noise, the model exact): the rejection rate at alpha = 0.05, 0.01, 0.001 is alpha
-    within 4 Monte Carlo standard errors; the single path's p-value is the batch's."""
+    """4000 clean rounds (paper noise, the model exact): the chi² test's rejection rate at alpha = 0.05, 0.01,
+    0.001 is alpha within 4 Monte Carlo standard errors; the largest standardised residual's (Sidak: an upper
+    bound of its p-value, whatever the residuals' correlation) at most alpha, and the fit check's (either test)
+    at most 2 alpha (the union bound), each within 4 Monte Carlo standard errors; the single path's p-values are
+    the batch's."""
     c = Case(mech)
     th = kin.ik(c.robot, c.robot.workspace.boundary_scheme(n))
     rng = np.random.default_rng([2024, n])
@@ -412,14 +415,20 @@ def test_false_rejection_rate_is_the_nominal_level(mech, n):
     R = np.array([c.plant.measure(th, PAPER, rng) for _ in range(N)])
     b = identify_batch(c.robot, th, R, "paper", noise=PAPER)
     assert b.success.all() and b.dof == th.shape[0] - 1 - len(c.names)
+    assert np.all(np.isfinite(b.p_value_max))
     for alpha in (0.05, 0.01, 0.001):
         k = int(np.sum(b.p_value < alpha))
-        sd = math.sqrt(N * alpha * (1 - alpha))
-        print(f"{mech} K={th.shape[0]} alpha={alpha}: {k} of {N} rejected (expected {N * alpha:.0f} +- {sd:.1f})")
+        km, kb = int(np.sum(b.p_value_max < alpha)), int(np.sum(b.rejected(alpha)))
+        sd, sd2 = math.sqrt(N * alpha * (1 - alpha)), math.sqrt(N * 2 * alpha * (1 - 2 * alpha))
+        print(f"{mech} K={th.shape[0]} alpha={alpha}: of {N}, the chi2 rejects {k} (expected {N * alpha:.0f} +- "
+              f"{sd:.1f}), the largest standardised residual {km} (at most {N * alpha:.0f}), either {kb} (at most "
+              f"{2 * N * alpha:.0f})")
         assert abs(k - N * alpha) <= 4 * sd + 1
+        assert km <= N * alpha + 4 * sd + 1 and kb <= 2 * N * alpha + 4 * sd2 + 1
     for i in range(5):
         res = identify_nlls(c.robot, Measurements(th, R[i]), noise=PAPER, accept_misfit=True)
         assert res.info["fit"]["p_value"] == pytest.approx(b.p_value[i], rel=1e-5)
+        assert res.info["fit"]["max_reading"]["p_value"] == pytest.approx(b.p_value_max[i], rel=1e-5)
 
 
 @pytest.mark.slow
@@ -436,10 +445,13 @@ def test_detection_rate_of_one_bad_reading(robot):
         for bad in (0.1, 0.5):
             Rb = R.copy()
             Rb[np.arange(1000), where] += bad
-            rates[K, bad] = float(np.mean(identify_batch(robot, th, Rb, "paper", noise=PAPER).p_value < 1e-3))
+            b = identify_batch(robot, th, Rb, "paper", noise=PAPER)
+            rates[K, bad] = float(np.mean(b.rejected(1e-3)))  # the fit check: either test
+            rates[K, bad, "chi2"] = float(np.mean(b.p_value < 1e-3))
     print(rates)
     assert 0.10 < rates[6, 0.1] < 0.22 and 0.86 < rates[6, 0.5] < 0.95
-    assert 0.58 < rates[12, 0.1] < 0.69 and rates[12, 0.5] > 0.99
+    assert rates[6, 0.1] == rates[6, 0.1, "chi2"]  # one spare degree of freedom: the second test adds nothing
+    assert 0.58 < rates[12, 0.1, "chi2"] < 0.69 and 0.68 < rates[12, 0.1] < 0.79 and rates[12, 0.5] > 0.99
 
 
 def test_banded_per_reading_terms_equal_the_dense_ones(case):

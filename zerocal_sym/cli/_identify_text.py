@@ -89,6 +89,10 @@ def accepted_why(fit: dict, alpha: float) -> str:
     if fit.get("accepted_despite_misfit") and fit.get("unchecked_after_removal"):
         return ("accepted despite misfit (--accept-misfit; NOT checked: no spare degree of freedom after the "
                 "readings left out)")
+    mr = fit.get("max_reading") or {}
+    if fit.get("accepted_despite_misfit") and mr.get("rejected") and not (p is not None and p < alpha):
+        return (f"accepted despite misfit (--accept-misfit; the largest standardised residual's p-value "
+                f"{mr['p_value']:.3g} < {alpha:g}, at pose {mr['pose']:g})")
     if fit.get("accepted_despite_misfit"):
         shown = "?" if p is None else f"{p:.3g}"
         return f"accepted despite misfit (--accept-misfit; fit p-value {shown} < {alpha:g})"

@@ -103,8 +103,8 @@ def add_arguments(p):
 def add_trust_arguments(p, nlls_default=True):
     """The fit-check and plausibility options, shared by identify and verify."""
     p.add_argument("--fit-alpha", type=float, default=0.001, metavar="ALPHA",
-                   help="significance level of the fit check: reject the fit when its chi2 p-value < ALPHA "
-                        "(default 0.001)")
+                   help="significance level of the fit check: reject the fit when its chi2 p-value or its "
+                        "largest standardised residual's p-value < ALPHA (default 0.001)")
     p.add_argument("--accept-misfit", action="store_true",
                    help="keep a calibration the fit check rejects (recorded in the result as accept_misfit)")
     p.add_argument("--loss", choices=["l2", "huber", "soft_l1"], default=None,

@@ -19,10 +19,12 @@ import numpy as np
 
 from zerocal_sym.errors import IdentificationError
 from zerocal_sym.identify import fisher
+from zerocal_sym.identify.check.max_reading import max_p_values
 from zerocal_sym.identify.estimate.nlls_inputs import index_list
 from zerocal_sym.identify.estimate.nlls_problem import GN_BLOCKS, get_problem
 from zerocal_sym.identify.estimate.nlls_solve import GN_STEP_TOL, noise_terms
 from zerocal_sym.identify.nlls import identify_nlls
+from zerocal_sym.identify.whitened import standardised_many
 from zerocal_sym.model.measurements import Measurements
 from zerocal_sym.model.noise import NoiseModel
 
@@ -55,6 +57,12 @@ class BatchResult:
         (:func:`zerocal_sym.identify.chi2.chi2_sf`; NaN where not
         available).  The batch does not reject: ``success`` means converged;
         compare ``p_value`` with a level (the single path's default 0.001).
+    p_value_max : ndarray, shape (N,)
+        The fit check's second p-value: of the largest ``|standardised
+        residual|`` over the K - 1 readings
+        (:func:`zerocal_sym.identify.check.max_reading.max_p_value`; NaN where
+        not available).  The single path rejects when either p-value is below
+        its level: :meth:`rejected`.
     """
 
     params: tuple
@@ -65,6 +73,11 @@ class BatchResult:
     chi2: np.ndarray
     dof: int = 0
     p_value: np.ndarray | None = None
+    p_value_max: np.ndarray | None = None
+
+    def rejected(self, alpha: float) -> np.ndarray:
+        """Where the single path's fit check would reject at ``alpha`` (bool (N,)): either p-value below it."""
+        return (self.p_value < alpha) | (self.p_value_max < alpha)
 
     def values(self, names) -> np.ndarray:
         """Columns of the estimate by name, shape (N, len(names))."""
@@ -74,24 +87,28 @@ class BatchResult:
 def _gauss_newton_blocks(prob, z, P):
     """Blocks of Gauss-Newton over the columns of (z, P), each data set until its last step is small.
 
-    Returns ``z`` (n, p), ``step`` (n,), whitened residuals ``r`` (n, K-1), data Jacobians ``J`` (n, K-1, p).
+    Returns ``z`` (n, p), ``step`` (n,), whitened residuals ``r`` (n, K-1), data Jacobians ``J`` (n, K-1, p),
+    the bidiagonal Cholesky factors of the changes' covariance ``l`` (n, K-1), ``b`` (n, K-2).
     """
     p, n = z.shape
     K = prob.K
     step = np.full(n, np.inf)
-    r = np.full((n, K - 1), np.nan)
+    r, l = np.full((n, K - 1), np.nan), np.full((n, K - 1), np.nan)
+    b = np.full((n, K - 2), np.nan)
     J = np.full((n, K - 1, p), np.nan)
     todo = np.arange(n)
     for _ in range(GN_BLOCKS):  # only the data sets not yet converged go on
-        zk, sk, rk, _, Jk, *_ = prob.run_batch(z[:, todo], P[:, todo])
+        zk, sk, rk, _, Jk, _, lk, bk = prob.run_batch(z[:, todo], P[:, todo])
         z[:, todo] = zk.reshape(p, todo.size, order="F")
         step[todo] = np.ravel(sk)
         r[todo] = rk.reshape(K - 1, todo.size, order="F").T
+        l[todo] = np.reshape(lk, (K - 1, todo.size), order="F").T
+        b[todo] = np.reshape(bk, (K - 2, todo.size), order="F").T
         J[todo] = Jk.reshape(K - 1 + p, p, todo.size, order="F").transpose(2, 0, 1)[:, : K - 1]  # [J_1 | J_2 | ...]
         todo = todo[~(step[todo] < GN_STEP_TOL) & np.all(np.isfinite(z[:, todo]), axis=0)]
         if not todo.size:
             break
-    return z.T, step, r, J
+    return z.T, step, r, J, l, b
 
 
 def _check_inputs(robot, theta_cmd, readings, names):
@@ -186,11 +203,13 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
             sub = identify_batch(robot, theta_cmd, R[keep], params, noise, prior)
             est = np.full((R.shape[0], len(names)), np.nan)
             std, chi2, pv = est.copy(), np.full(R.shape[0], np.nan), np.full(R.shape[0], np.nan)
+            pvm = pv.copy()
             success, confirmed = np.zeros(R.shape[0], bool), np.zeros(R.shape[0], bool)
             est[keep], std[keep], chi2[keep], pv[keep] = sub.estimate, sub.std, sub.chi2, sub.p_value
+            pvm[keep] = sub.p_value_max
             success[keep], confirmed[keep] = sub.success, sub.confirmed
             return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed,
-                               chi2=chi2, dof=sub.dof, p_value=pv)
+                               chi2=chi2, dof=sub.dof, p_value=pv, p_value_max=pvm)
     theta_cmd, readings = _check_inputs(robot, theta_cmd, readings, names)
     N, K = readings.shape
     prior_q = errors.zeros() if prior is None else errors.check_vector(prior, "prior")
@@ -206,14 +225,14 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
     z0 = mu * scale
     est = np.full((N, p), np.nan)
     std = np.full((N, p), np.nan)
-    chi2 = np.full(N, np.nan)
+    chi2, tmax, ntest = np.full(N, np.nan), np.full(N, np.nan), np.zeros(N, int)
     confirmed = np.zeros(N, bool)
     # the shared revisit error makes the covariance more than the bands the batch whitens by: the single path
     for a in range(0, 0 if noise.has_shared else N, CHUNK):
         n = min(CHUNK, N - a)
         P = np.repeat(par[:, None], n, axis=1)
         P[srows] = readings[a:a + n, 1:].T
-        z, step, r, J = _gauss_newton_blocks(prob, np.repeat(z0[:, None], n, axis=1), P)
+        z, step, r, J, lb, bb = _gauss_newton_blocks(prob, np.repeat(z0[:, None], n, axis=1), P)
         ok = np.isfinite(step) & (step < GN_STEP_TOL) & np.all(np.isfinite(z), axis=1)
         F = np.einsum("nki,nkj->nij", J, J)
         try:
@@ -229,6 +248,10 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
         est[sl] = z[ok] / scale
         std[sl] = np.sqrt(np.abs(np.diagonal(cov, axis1=1, axis2=2)) * s2) / scale
         chi2[sl] = np.sum(r[ok] ** 2, axis=1)
+        if K - 1 > p and ok.any():  # the largest |standardised residual| (the fit check's second test)
+            t = np.abs(standardised_many(r[ok], J[ok], lb[ok], bb[ok])[0])
+            ntest[sl] = np.sum(np.isfinite(t), axis=1)
+            tmax[sl] = np.max(np.where(np.isfinite(t), t, -np.inf), axis=1)
         confirmed[sl] = True
     success = confirmed.copy()
     for k in np.flatnonzero(~confirmed):  # the single path decides
@@ -238,12 +261,17 @@ def identify_batch(robot, theta_cmd, readings, params="paper", noise: NoiseModel
             est[k] = res.estimate
             std[k] = [res.std(nm) for nm in names]
             chi2[k] = res.info["chi2"]
+            mr = res.info["fit"].get("max_reading") or {}
+            if mr.get("p_value") is not None:
+                tmax[k], ntest[k] = abs(mr["standardised"]), mr["readings"]
             success[k] = True
     from zerocal_sym.identify.chi2 import chi2_sf_array
 
     dof = K - 1 - p
-    pv = np.full(N, np.nan)
+    pv, pvm = np.full(N, np.nan), np.full(N, np.nan)
     if dof > 0 and not noise.is_zero:
         pv = np.where(np.isfinite(chi2), chi2_sf_array(np.where(np.isfinite(chi2), chi2, 0.0), dof), np.nan)
+        has = np.isfinite(tmax) & (ntest > 0)
+        pvm[has] = max_p_values(tmax[has], ntest[has])
     return BatchResult(params=names, estimate=est, std=std, success=success, confirmed=confirmed, chi2=chi2,
-                       dof=dof, p_value=pv)
+                       dof=dof, p_value=pv, p_value_max=pvm)

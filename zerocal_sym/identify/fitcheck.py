@@ -22,6 +22,15 @@ chi² test
     freedom (``dof = 0``) or a zero noise model (noise-free weighting by 1 um
     has no noise level to test against).
 
+Largest standardised residual
+    The second test (:mod:`~zerocal_sym.identify.check.max_reading`): the
+    largest ``|t_k|`` (below) over the testable readings, its p-value by
+    Sidak's correction for their number (an upper bound, whatever their
+    correlation); the fit is also **rejected** when it is below ``alpha`` --
+    one reading far off among many, which the chi² dilutes.  The status then
+    names that reading (its cause: the exact refit without it).  Together the
+    two tests refuse a clean round at most ``2 alpha`` of the time.
+
 Per reading
     For reading ``k`` (the change from pose ``k-1`` to pose ``k``) the
     standardised residual is the mean-shift outlier statistic

@@ -53,7 +53,8 @@ import time
 import numpy as np
 
 from zerocal_sym.identify import banded, fisher
-from zerocal_sym.identify.check.robust_fit import limit_outliers, robust_linear, unchecked_after_removal
+from zerocal_sym.identify.check.robust_fit import (kept_outlier, limit_outliers, robust_linear,
+                                                   unchecked_after_removal)
 from zerocal_sym.identify.check.statistics import DEFAULT_ALPHA
 from zerocal_sym.identify.estimate import robust as rb
 from zerocal_sym.identify.estimate.nlls_banded import round_problem
@@ -272,6 +273,7 @@ def identify_nlls(robot, meas, params="paper", noise: NoiseModel | None = None, 
     check_result(robot, meas, res, lin, noise, names, prior_q, fit_alpha, accept_misfit,
                  prior_whitener=w if has_prior else None, evaluated_at=at, active_bounds=active)
     if robust is not None:
+        kept_outlier(res, robust, loss)
         limit_outliers(res, robust, loss, K, accept_misfit)
         unchecked_after_removal(res, robust, loss, K, accept_misfit)
     revisits_entry(res, robot, theta_cmd, s - pred, sol, A, K, noise, names, prior_q, scale)

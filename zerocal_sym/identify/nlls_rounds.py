@@ -8,12 +8,13 @@ Function evaluates it).  A round whose Gauss-Newton converged and passes Ipopt's
 (:func:`~zerocal_sym.identify.estimate.nlls_solve.ipopt_accepts`, as ``identify_nlls`` confirms it) gets the
 estimate, covariance and verdict ``identify_nlls`` would give, from the same functions on the same arrays
 (:func:`~zerocal_sym.identify.estimate.nlls_solve.information`, the fit check's chi² test
-:func:`~zerocal_sym.identify.check.statistics.chi2_test`): the same numbers, bit for bit.  Every other round goes
+:func:`~zerocal_sym.identify.check.statistics.chi2_test` and its largest standardised residual
+:func:`~zerocal_sym.identify.check.max_reading.max_test`): the same numbers, bit for bit.  Every other round goes
 through :func:`~zerocal_sym.identify.nlls.identify_nlls` itself.
 
 What a loop reads of a round (``lean`` results): ``success``, ``status``, the estimate and covariance,
-``info["fit"]["rejected"]``; the fit check's per-reading statistics and the diagnosis of a rejected fit are
-not computed (``info["lean"]`` is True): ``zerocal compare`` does not report them.  Shapes: K poses, m
+``info["fit"]["rejected"]`` (and ``max_reading``); the fit check's per-reading statistics and the diagnosis of a
+rejected fit are not kept (``info["lean"]`` is True): ``zerocal compare`` does not report them.  Shapes: K poses, m
 joints, q source errors, p estimated parameters.
 """
 from __future__ import annotations
@@ -24,6 +25,7 @@ import numpy as np
 
 from zerocal_sym.errors import IdentificationError, ZerocalError
 from zerocal_sym.identify import fisher
+from zerocal_sym.identify.check.max_reading import max_test
 from zerocal_sym.identify.check.statistics import DEFAULT_ALPHA, chi2_test
 from zerocal_sym.identify.estimate.nlls_inputs import prior_whitener
 from zerocal_sym.identify.estimate.nlls_problem import EXPAND_MAX_K, GN_BLOCKS, get_problem
@@ -75,9 +77,26 @@ class _Verdict:
         self.dof = r.size - rank
 
 
-def _lean(robot, names, scale, noise, prior_q, w, sol, K, alpha) -> IdentificationResult:
+def _max_reading(prob, lin, sol, svd, rank, K, names, scale, alpha, checked):
+    """The fit check's largest standardised residual and its test, from the per-reading terms ``identify_nlls``
+    computes for the same point (the compiled ``fit_terms`` without prior rows at full rank, else
+    :meth:`_Linear.per_reading`): None when not checked."""
+    if not checked or not lin.valid:
+        return None
+    if isinstance(lin, _Linear):  # prior rows
+        t, _, delta, _ = lin.per_reading(moves=False)
+    elif rank == len(names) and "fit_terms" in prob.fast:
+        t, _, delta, _ = (np.ravel(np.array(o, float)) for o in prob.fast["fit_terms"](sol.r, sol.J[: K - 1], sol.l,
+                                                                                       sol.b))
+    else:
+        t, _, delta, _ = _Linear(sol.r, sol.J[: K - 1], (sol.l, sol.b), np.arange(1, K), np.zeros(K - 1),
+                                 np.eye(len(names)), scale, names, 0, svd=svd).per_reading(moves=False)
+    return max_test(t, np.arange(1, K), delta, alpha, checked)
+
+
+def _lean(robot, names, scale, noise, prior_q, w, sol, K, alpha, prob) -> IdentificationResult:
     """The result ``identify_nlls`` gives for a confirmed point ``sol``: its estimate, covariance and verdict (the
-    fit check's chi² test; the per-reading statistics and a rejection's diagnosis left out)."""
+    fit check's two tests; the per-reading statistics and a rejection's diagnosis left out)."""
     errors = robot.errors
     r, rp, J, l, b = sol.r, sol.rp, sol.J, sol.l, sol.b
     has_prior = bool(w.any())
@@ -92,14 +111,22 @@ def _lean(robot, names, scale, noise, prior_q, w, sol, K, alpha) -> Identificati
     else:  # the same quantities from J's SVD (as _Linear takes it: the data rows are all of J's information)
         lin = _Verdict(r, Jd, l, b, svd)
     chi2, dof, checked, rejected, p, _ = chi2_test(lin, noise, alpha)
+    mr = _max_reading(prob, lin, sol, svd, rank, K, names, scale, alpha, checked)
     if rejected and success:
         success = False
         status = "rejected: the noise model rejects the fit" + (f" (chi2 {chi2:.4g} on {dof} dof, p = {p:.3g})"
                                                                if np.isfinite(chi2) else "")
+    elif mr is not None and mr["rejected"] and success:
+        success = False
+        status = (f"rejected: the noise model rejects the fit (one reading: standardised residual "
+                  f"{mr['standardised']:+.3g} at pose {mr['pose']}, the largest of {mr['readings']}, "
+                  f"p = {mr['p_value']:.3g})")
     info = {"solver_status": sol.ret, "iterations": sol.iterations, "chi2": float(r @ r), "rank": rank,
             "confirmation": sol.confirmation, "prior": prior_q.tolist(), "nonidentifiable": nonid,
             "noise": {"sigma_scale_mm": noise.sigma_scale_mm, "sigma_servo_rad": noise.sigma_servo_rad},
-            "fit": {"checked": checked, "rejected": rejected, "chi2": chi2, "dof": dof, "p_value": p, "alpha": alpha},
+            "fit": {"checked": checked, "rejected": bool(rejected or (mr is not None and mr["rejected"])),
+                    "chi2_rejected": rejected, "chi2": chi2, "dof": dof, "p_value": p, "alpha": alpha,
+                    "max_reading": mr},
             "lean": True}
     return IdentificationResult(method="nlls", params=names, estimate=sol.z / scale, covariance=cov,
                                 success=bool(success), status=status, info=info, errors=errors,
@@ -177,7 +204,7 @@ def identify_rounds(robot, rounds, priors, params, noise, prior_covs=None, alpha
             continue
         sol = SimpleNamespace(z=z, ret="Solve_Succeeded", converged=True, iterations=0, gn_ok=True, step=step,
                               l=l, b=b, r=r, rp=rp, J=J, pred=pred, confirmation="first-order test")
-        out[i] = _lean(robot, names, scale, noise, np.asarray(priors[i], float), ws[i], sol, K, alpha)
+        out[i] = _lean(robot, names, scale, noise, np.asarray(priors[i], float), ws[i], sol, K, alpha, prob)
     return out
 
 

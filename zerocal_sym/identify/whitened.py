@@ -120,3 +120,24 @@ class _Linear:
             dz = np.full((n, self.basis.shape[0]), np.nan)
         dz[~ok] = np.nan
         return t, lev, delta, dz
+
+
+def standardised_many(r, J, l, b) -> tuple:
+    """:meth:`_Linear.per_reading`'s ``(t, delta)`` of N data sets at once, whitened by the bands (no prior rows).
+
+    ``r`` (N, n) whitened residuals, ``J`` (N, n, c) whitened Jacobians, ``l`` (N, n) and ``b`` (N, n-1) the
+    bidiagonal Cholesky factors: the same formulas (the hat matrix from each ``J``'s thin SVD, its rank by
+    :data:`RANK_RTOL`), batched over the data sets, O(N n c) time and memory.  NaN where a reading is not
+    testable (:data:`LEVERAGE_TOL`)."""
+    r, J = np.asarray(r, float), np.asarray(J, float)
+    U, s, _ = np.linalg.svd(J, full_matrices=False)                    # (N, n, c), (N, c)
+    U = U * (s > RANK_RTOL * s[:, :1])[:, None, :]                      # the columns beyond each rank dropped
+    aa = banded.inverse_diagonal(l, b)                                  # (N, n)
+    UA = banded.backward(l, b, U)                                       # row j: U^T a_j
+    den = aa - np.sum(UA * UA, axis=2)
+    num = banded.backward(l, b, r) - np.einsum("njc,nc->nj", UA, np.einsum("njc,nj->nc", U, r))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ok = den > LEVERAGE_TOL * aa
+        t = np.where(ok, num / np.sqrt(np.where(ok, den, 1.0)), np.nan)
+        delta = np.where(ok, num / np.where(ok, den, 1.0), np.nan)
+    return t, delta

@@ -138,7 +138,8 @@ def fit_record(rf):
         ``chi2``, ``dof``, ``p_value``, ``alpha`` (float or None); ``checked``, ``rejected``,
         ``accepted_despite_misfit`` (bool); ``reason``, ``diagnosis`` (str or None); ``warnings`` (list of str);
         ``readings`` [{``pose``, ``standardised``}]; ``worst`` ({``pose``, ``from_pose``, ``standardised``,
-        ``estimated_error_mm``} or None).
+        ``estimated_error_mm``} or None); ``max_reading`` (the largest standardised residual's test:
+        {``pose``, ``standardised``, ``readings``, ``p_value``, ``rejected``} or None).
     """
     fit, src = rf.raw.get("fit"), rf.source
     if fit is None:
@@ -164,6 +165,14 @@ def fit_record(rf):
         raise DataFileError(f"{what}: 'worst' must be an object (the worst reading)", where=src)
     out["worst"] = None if w is None else {k: _read(w, k, "number", src, f"{what} worst") for k in
                                            ("pose", "from_pose", "standardised", "estimated_error_mm")}
+    m = fit.get("max_reading")
+    if m is not None and not isinstance(m, dict):
+        raise DataFileError(f"{what}: 'max_reading' must be an object (the largest standardised residual's test)",
+                            where=src)
+    out["max_reading"] = None if m is None else {
+        **{k: _read(m, k, "number", src, f"{what} max_reading") for k in ("pose", "standardised", "readings",
+                                                                           "p_value")},
+        "rejected": _read(m, "rejected", "bool", src, f"{what} max_reading") is True}
     return out
 
 

@@ -130,6 +130,13 @@ def _fit(c, fig_png) -> str:
     body = (f"<p>chi2 {num(fit.get('chi2'), '.4g', tag='span')} on {num(fit.get('dof'), 'g', tag='span')} degrees "
             f"of freedom, p-value {num(fit.get('p_value'), '.3g', tag='span')} against the significance level "
             f"{num(fit.get('alpha'), 'g', tag='span')}: <strong>{esc(decision)}</strong>.</p>")
+    m = fit.get("max_reading")
+    if m is not None and m.get("rejected") and m.get("pose") is not None:
+        body += (f'<p id="max-reading">The largest standardised residual, '
+                 f"{num(m.get('standardised'), '+.3f', tag='span')} at <strong>pose {m['pose']:g}</strong>, has "
+                 f"p-value {num(m.get('p_value'), '.3g', tag='span')} for the largest of "
+                 f"{num(m.get('readings'), 'g', tag='span')} readings: below the significance level, the data "
+                 "contradict the noise model at that reading whatever the chi2 says.</p>")
     w = fit.get("worst")
     if w is not None and w.get("pose") is not None:
         frm = "?" if w.get("from_pose") is None else f"{w['from_pose']:g}"

@@ -2,10 +2,12 @@
 
 A robust loss (:mod:`zerocal_sym.identify.estimate.robust`) down-weights
 readings; those whose weight ends below :data:`ROBUST_EXCLUDE_WEIGHT` are its
-outliers.  :func:`robust_linear` is the fit check's problem without them;
-:func:`limit_outliers` rejects a fit that left out more than
-:func:`robust_exclusion_limit` allows, :func:`unchecked_after_removal` one
-that has no spare degree of freedom left to be checked.
+outliers.  :func:`robust_linear` is the fit check's problem without them (both
+tests see only the readings kept); :func:`limit_outliers` rejects a fit that
+left out more than :func:`robust_exclusion_limit` allows,
+:func:`unchecked_after_removal` one that has no spare degree of freedom left
+to be checked; :func:`kept_outlier` says when the reading the largest
+standardised residual rejects is one the loss down-weighted but kept.
 """
 from __future__ import annotations
 
@@ -92,3 +94,20 @@ def limit_outliers(res, robust, loss, K, accept_misfit):
                         f"{', '.join(map(str, robust['excluded_readings']))}: more than {limit} of {K - 1}, so the "
                         "data do not fit the model, whatever the few readings left say"
                         + (f" (of those: {kept[0].lower() + kept[1:]})" if kept else "."))
+
+
+def kept_outlier(res, robust, loss):
+    """Say so when the reading that the fit check's largest standardised residual rejects is one the loss
+    down-weighted but kept (its weight at least :data:`ROBUST_EXCLUDE_WEIGHT`): the fit stays rejected (the
+    data contradict the noise model at that reading), and the paragraph tells how to leave it out."""
+    fit = res.info["fit"]
+    mr = fit.get("max_reading") or {}
+    if not (fit.get("rejected") and mr.get("rejected")):
+        return
+    w = float(robust["weights"][mr["pose"] - 1])
+    if w >= 1.0:
+        return
+    note = (f" The {loss} loss down-weighted the reading at pose {mr['pose']} (weight {w:.2g}) but kept it: it "
+            f"leaves out the readings weighted below {ROBUST_EXCLUDE_WEIGHT:g}; a smaller --loss-scale leaves this one "
+            "out, or re-measure it.")
+    fit["diagnosis"] = (fit.get("diagnosis") or "") + note

@@ -1,9 +1,10 @@
-"""The fit check's test: the chi² of the whitened exact-model residuals against the noise model, and the
-statistics of every reading.
+"""The fit check's tests: the chi² of the whitened exact-model residuals against the noise model, the largest
+standardised residual against it, and the statistics of every reading.
 
-:func:`chi2_test` is the test alone; :func:`statistics` the test and the
+:func:`chi2_test` is the chi² test alone; :func:`statistics` both tests (the
+second: :func:`~zerocal_sym.identify.check.max_reading.max_test`) and the
 per-reading statistics (:meth:`~zerocal_sym.identify.whitened._Linear.per_reading`)
-as the JSON-ready dict a result carries in ``info["fit"]``.  The test, the
+as the JSON-ready dict a result carries in ``info["fit"]``.  The tests, the
 statistics and their definitions: :mod:`zerocal_sym.identify.fitcheck`.
 """
 from __future__ import annotations
@@ -12,11 +13,12 @@ import math
 
 import numpy as np
 
+from zerocal_sym.identify.check.max_reading import max_test
 from zerocal_sym.identify.chi2 import _fmt_p, _gamma_pq, chi2_sf
 from zerocal_sym.identify.result import _noise_dict
 from zerocal_sym.identify.whitened import _Linear
 
-#: significance level of the fit check (reject when p < alpha)
+#: significance level of each of the fit check's two tests (reject when either p < alpha)
 DEFAULT_ALPHA = 1e-3
 
 
@@ -34,10 +36,12 @@ def chi2_test(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> tuple:
 
 
 def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
-    """The chi² test and the per-reading statistics of a linearised, whitened fit (JSON-ready dict).
+    """The two tests and the per-reading statistics of a linearised, whitened fit (JSON-ready dict).
 
     Keys: ``checked``, ``reason`` (why not, if not), ``chi2``, ``dof``,
-    ``p_value``, ``p_value_lower``, ``alpha``, ``rejected``, ``rms_whitened``,
+    ``p_value``, ``p_value_lower`` (the chi² test's), ``alpha``, ``rejected``
+    (by either test), ``chi2_rejected``, ``max_reading`` (the largest
+    ``|standardised|`` and its test: :func:`~zerocal_sym.identify.check.max_reading.max_test`), ``rms_whitened``,
     ``readings`` (per reading: ``pose``, ``from_pose``, ``residual_mm``,
     ``whitened``, ``leverage``, ``standardised``, ``estimated_error_mm``),
     ``worst`` (the reading with the largest ``|standardised|``, with the chi²
@@ -83,5 +87,9 @@ def statistics(lin: _Linear, noise, alpha: float = DEFAULT_ALPHA) -> dict:
             c = max(chi2 - float(t[j]) ** 2, 0.0)
             w.update(chi2_without=c, p_value_without=chi2_sf(c, dof - 1))
         fit["worst"] = w
+    fit["max_reading"] = max_test(t, lin.poses[:n], delta, alpha, checked)
+    fit["chi2_rejected"] = rejected
+    if fit["max_reading"] is not None and fit["max_reading"]["rejected"]:
+        fit["rejected"] = True
     fit["_t"] = t  # private: for the diagnosis (removed before returning to the user)
     return fit

@@ -3,8 +3,9 @@
 :func:`_diagnose` looks for them (the user's bounds or prior against the
 data, readings of the wrong sign or cumulative, poses out of order, one bad
 reading -- each an exact-model refit) and :func:`_paragraph` writes
-``fit["diagnosis"]``; :mod:`~zerocal_sym.identify.diagnose.verdict` adds them
-to the statistics of :func:`~zerocal_sym.identify.check.statistics.statistics`.
+``fit["diagnosis"]``; :func:`_diagnose_max` does both for a fit that only the
+largest standardised residual rejects (the chi² passes: the reading it names);
+:mod:`~zerocal_sym.identify.diagnose.verdict` adds them to the statistics of :func:`~zerocal_sym.identify.check.statistics.statistics`.
 The causes and when each is detected: :mod:`zerocal_sym.identify.fitcheck`.
 """
 from __future__ import annotations
@@ -179,3 +180,38 @@ def _paragraph(fit: dict, causes: list, alpha: float, exact) -> str:
         checked = ("Checked and not found: poses visited in reverse or two consecutive poses swapped, cumulative "
                    "readings (head not reset), sign-flipped readings." if exact is not None else "")
     return head + " Likely causes: " + "; ".join(parts) + ". " + checked
+
+
+def _diagnose_max(exact: _Exact | None, fit: dict, alpha: float, z_est=None) -> tuple:
+    """(causes, paragraph) of a fit rejected by the largest standardised residual alone (the chi² passes).
+
+    The cause is that reading, named as :func:`_diagnose` names a bad reading: its estimated error and the chi²
+    without it from the exact refit without it (from the prior and from ``z_est``), or, without ``exact`` or
+    where that refit fails, from the model linearised at the estimate (``estimated_error_mm``, ``chi2 - t^2``).
+    """
+    mr = fit["max_reading"]
+    k, j = mr["pose"], mr["pose"] - 1
+    e, c, d = mr["estimated_error_mm"], max(fit["chi2"] - mr["standardised"] ** 2, 0.0), fit["dof"] - 1
+    if exact is not None and j < exact.K - 1:
+        try:
+            out = _without_each(exact, z_est, select=lambda c_, c0, d_: np.arange(c_.size) == j)
+            if np.isfinite(out["chi2"][j]) and np.isfinite(out["dropped_error_mm"][j]):
+                e, c, d = float(out["dropped_error_mm"][j]), float(out["chi2"][j]), int(out["dof"][j])
+        except Exception:  # noqa: BLE001 - then the linearised values
+            pass
+    text = f"the reading at pose {k} (the change from pose {k - 1} to pose {k})" + (
+        f" is off by about {e:+.3g} mm" if e is not None else " is off")
+    ev = (f"its standardised residual {mr['standardised']:+.3g} is the largest of {mr['readings']} "
+          f"({_fmt_p(mr['p_value'])} for the largest of {mr['readings']} under the noise model, below {alpha:g})")
+    if d > 0:
+        ev += f"; without it chi2 = {c:.4g} on {d} dof ({_fmt_p(chi2_sf(c, d))})"
+    causes = [{"cause": "bad reading", "detected": True, "pose": int(k), "from_pose": int(k - 1),
+               "estimated_error_mm": e, "text": text, "evidence": ev, "also_possible": [], "test": "max_reading"}]
+    head = (f"The noise model rejects this fit: one reading is further off than the noise model allows among "
+            f"{mr['readings']} readings (the largest standardised residual, {mr['standardised']:+.3g} at pose {k}: "
+            f"{_fmt_p(mr['p_value'])}, below {alpha:g}), though chi2 = {fit['chi2']:.4g} on {fit['dof']} degrees of "
+            f"freedom passes ({_fmt_p(fit['p_value'])}).")
+    body = (f" Likely cause (detected): {text}: {ev}. (A robot-file error that shows mostly in this change looks the "
+            f"same in one round: re-measure pose {k} to tell.) Otherwise check the robot file, the noise model and "
+            "the readings.")
+    return causes, head + body

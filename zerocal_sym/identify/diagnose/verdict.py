@@ -1,7 +1,8 @@
 """The verdict of a fit check in the result: the causes added to a rejected fit, the result's status.
 
 :func:`finish` adds the causes and the paragraph
-(:mod:`~zerocal_sym.identify.diagnose.causes`) to the statistics of
+(:mod:`~zerocal_sym.identify.diagnose.causes`; a fit rejected by the largest
+standardised residual alone: the reading it names) to the statistics of
 :func:`~zerocal_sym.identify.check.statistics.statistics`; :func:`apply`
 records the fit in a result and, when it is rejected, changes its
 ``success`` and ``status``.
@@ -11,12 +12,24 @@ from __future__ import annotations
 import math
 
 from zerocal_sym.identify.chi2 import _fmt_p
-from zerocal_sym.identify.diagnose.causes import _diagnose
+from zerocal_sym.identify.diagnose.causes import _diagnose, _diagnose_max
 from zerocal_sym.identify.estimate.exact_model import _Exact
 
 
+def _max_only(fit: dict) -> bool:
+    """Whether only the largest standardised residual rejects the fit (the chi² passes)."""
+    return bool(fit["rejected"] and not fit.get("chi2_rejected", True)
+                and (fit.get("max_reading") or {}).get("rejected"))
+
+
 def _summary(fit: dict) -> str:
-    s = f"chi2 {fit['chi2']:.4g} on {fit['dof']} dof, {_fmt_p(fit['p_value'])}, below {fit['alpha']:g}"
+    if _max_only(fit):
+        mr = fit["max_reading"]
+        s = (f"one reading: standardised residual {mr['standardised']:+.3g} at pose {mr['pose']}, the largest of "
+             f"{mr['readings']}, {_fmt_p(mr['p_value'])}, below {fit['alpha']:g}, though chi2 {fit['chi2']:.4g} on "
+             f"{fit['dof']} dof, {_fmt_p(fit['p_value'])}, passes")
+    else:
+        s = f"chi2 {fit['chi2']:.4g} on {fit['dof']} dof, {_fmt_p(fit['p_value'])}, below {fit['alpha']:g}"
     det = [c for c in fit.get("causes", []) if c.get("detected")]
     if det:
         s += f"; likely: {det[0]['text']}"
@@ -26,7 +39,9 @@ def _summary(fit: dict) -> str:
 def finish(fit: dict, exact: _Exact | None, diagnose: bool = True, z_est=None) -> dict:
     """Add the causes and the paragraph to a rejected fit; drop the private arrays."""
     fit["causes"], fit["diagnosis"] = [], None
-    if fit["rejected"]:
+    if _max_only(fit):  # the reading it names (its exact refit only when diagnosing)
+        fit["causes"], fit["diagnosis"] = _diagnose_max(exact if diagnose else None, fit, fit["alpha"], z_est)
+    elif fit["rejected"]:
         if diagnose:
             fit["causes"], fit["diagnosis"] = _diagnose(exact, fit, fit["alpha"], z_est)
         else:
