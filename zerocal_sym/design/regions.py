@@ -309,22 +309,29 @@ class ReachableRegion(CentredBox):
 
 def _feasible(robot, P, margin, jl_rad, signs):
     """Per-pose feasibility of the reachable set (no clip), bool shape (K,)."""
-    from zerocal_sym.design.terms import _call_ik, _reachable, pose_terms
-    from zerocal_sym.model import kinematics as kin
+    return _feasible_terms(robot, P, margin, jl_rad, signs)[0]
+
+
+def _feasible_terms(robot, P, margin, jl_rad, signs):
+    """:func:`_feasible` and the design terms of the feasible poses (:func:`zerocal_sym.design.constraints.take_terms`),
+    from one evaluation of the terms."""
+    from zerocal_sym.design.calls import fk
+    from zerocal_sym.design.constraints import take_terms
+    from zerocal_sym.design.terms import _reachable, pose_terms
 
     P = np.atleast_2d(P)
-    th, ratio = _call_ik(robot, P)
-    ok = _reachable(ratio, th, 1e-9)
+    t = pose_terms(robot, P)
+    ok = _reachable(t["ratio"], t["theta"], 1e-9)
+    t = take_terms(t, ok)
     if not np.any(ok):
-        return ok
-    t = pose_terms(robot, P[ok])
+        return ok, t
     good = np.min(t["s"] * signs, axis=1) >= margin + 1e-9
     if jl_rad is not None:
         good &= np.all((t["theta"] >= jl_rad[:, 0] + 1e-9) & (t["theta"] <= jl_rad[:, 1] - 1e-9), axis=1)
-    back = kin.fk(robot, t["theta"])
+    back = fk(robot, t["theta"])
     good &= np.linalg.norm(back - P[ok], axis=1) < 1e-6
     ok[np.flatnonzero(ok)] = good
-    return ok
+    return ok, take_terms(t, good)
 
 
 def mode_signs(robot) -> np.ndarray:
