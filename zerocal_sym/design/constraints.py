@@ -318,14 +318,16 @@ def _pointwise(robot, P, cons: Constraints):
     else:
         t = pose_terms(robot, P[ok])
         good = _reachable(t["ratio"], t["theta"], 1e-9)
-        t = take_terms(t, good)
-        if np.any(good):
-            sub = np.min(np.abs(t["s"]), axis=1) >= cons.singularity_margin + 1e-9
+        sel = np.flatnonzero(good)
+        if len(sel):
+            sub = np.min(np.abs(t["s"][sel]), axis=1) >= cons.singularity_margin + 1e-9
             if cons.joint_limits is not None:
                 jl = cons.joint_limits_internal()
-                sub &= np.all((t["theta"] >= jl[:, 0] + 1e-9) & (t["theta"] <= jl[:, 1] - 1e-9), axis=1)
-            good[np.flatnonzero(good)] = sub
-            t = take_terms(t, sub)
+                theta = t["theta"][sel]
+                sub &= np.all((theta >= jl[:, 0] + 1e-9) & (theta <= jl[:, 1] - 1e-9), axis=1)
+            good[sel] = sub
+            sel = sel[sub]
+        t = take_terms(t, sel)
     ok[idx] = good
     return ok, (t if np.any(good) else None)
 

@@ -100,14 +100,16 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
                 free = np.setdiff1d(np.arange(N), idx)
                 trial = np.repeat(idx[None], len(free), axis=0)
                 trial[:, pos] = free
-                o = fn(trial)
+                # the objective of the trials that keep the travel and the separation (the others: inf)
                 if cons.travel_mode == "range":
-                    o[np.ptp(rho[trial], axis=1) > cons.travel_mm] = np.inf
+                    keep = ~(np.ptp(rho[trial], axis=1) > cons.travel_mm)
                 else:
-                    o[np.max(np.abs(np.diff(rho[trial], axis=1)), axis=1) > cons.travel_mm] = np.inf
+                    keep = ~(np.max(np.abs(np.diff(rho[trial], axis=1)), axis=1) > cons.travel_mm)
                 if close is not None:
-                    others = np.delete(idx, pos)
-                    o[np.any(close[np.ix_(free, others)], axis=1)] = np.inf
+                    keep &= ~np.any(close[np.ix_(free, np.delete(idx, pos))], axis=1)
+                o = np.full(len(free), np.inf)
+                if np.any(keep):
+                    o[keep] = fn(trial[keep])
                 k = int(np.argmin(o))
                 if o[k] < cur - 1e-10 * max(abs(cur), 1.0):
                     idx, cur, improved = trial[k], o[k], True

@@ -322,16 +322,16 @@ def _feasible_terms(robot, P, margin, jl_rad, signs):
     P = np.atleast_2d(P)
     t = pose_terms(robot, P)
     ok = _reachable(t["ratio"], t["theta"], 1e-9)
-    t = take_terms(t, ok)
-    if not np.any(ok):
-        return ok, t
-    good = np.min(t["s"] * signs, axis=1) >= margin + 1e-9
-    if jl_rad is not None:
-        good &= np.all((t["theta"] >= jl_rad[:, 0] + 1e-9) & (t["theta"] <= jl_rad[:, 1] - 1e-9), axis=1)
-    back = fk(robot, t["theta"])
-    good &= np.linalg.norm(back - P[ok], axis=1) < 1e-6
-    ok[np.flatnonzero(ok)] = good
-    return ok, take_terms(t, good)
+    idx = np.flatnonzero(ok)
+    if len(idx):
+        theta = t["theta"][idx]
+        good = np.min(t["s"][idx] * signs, axis=1) >= margin + 1e-9
+        if jl_rad is not None:
+            good &= np.all((theta >= jl_rad[:, 0] + 1e-9) & (theta <= jl_rad[:, 1] - 1e-9), axis=1)
+        good &= np.linalg.norm(fk(robot, theta) - P[idx], axis=1) < 1e-6
+        ok[idx] = good
+        idx = idx[good]
+    return ok, take_terms(t, idx)
 
 
 def mode_signs(robot) -> np.ndarray:

@@ -77,8 +77,9 @@ SMALLEST_CHUNK, LARGEST_CHUNK = 8, 1024
 class Columns:
     """``f`` (dense column-vector outputs) over any number N of columns of its per-pose inputs, zero-copy.
 
-    A call splits the N columns into chunks of :data:`LARGEST_CHUNK`, then of the largest power of two that
-    fits, the last chunk (fewer than :data:`SMALLEST_CHUNK`) padded with copies of its last column; each chunk
+    A call splits the N columns into chunks of :data:`LARGEST_CHUNK`, then of the power of two that holds the
+    rest if that pads it by at most an eighth (or :data:`SMALLEST_CHUNK` columns), else of the largest power of
+    two within it; padding columns are copies of the chunk's last; each chunk
     runs through a :class:`FastCall` of ``f`` mapped over that size (the shared inputs not repeated), built once
     per size.  Every column is evaluated by ``f`` alone, as a call of ``f`` on the N columns would: the
     numbers are the same whatever the chunks.
@@ -107,8 +108,11 @@ class Columns:
         start = 0
         while start < N:
             r = N - start
-            B = LARGEST_CHUNK if r >= LARGEST_CHUNK else (1 << (r.bit_length() - 1) if r >= SMALLEST_CHUNK
-                                                         else SMALLEST_CHUNK)
+            B = max(SMALLEST_CHUNK, 1 << (r - 1).bit_length())  # the power of two that holds the rest
+            if B > LARGEST_CHUNK:
+                B = LARGEST_CHUNK
+            elif B - r > max(SMALLEST_CHUNK, r // 8):  # too much padding: the largest power of two within it
+                B //= 2
             n = min(B, r)
             chunk = []
             for a, pp in zip(args, self.per_pose):
