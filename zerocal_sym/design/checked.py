@@ -21,7 +21,8 @@ import numpy as np
 from zerocal_sym.design.certify import directions
 from zerocal_sym.design.constraints import Constraints, _pointwise_ok, check_design
 from zerocal_sym.design.criteria import _noise_terms
-from zerocal_sym.design.detection import ORDER_MARGIN, PENALTY, Requirement, Terms, detection, evaluate_batch
+from zerocal_sym.design.detection import (ORDER_MARGIN, PENALTY, Requirement, Terms, crlb_objective_batch,
+                                          detection, evaluate_batch)
 from zerocal_sym.design.terms import _crlb_weights, offset_positions
 
 #: pattern search: the first step as a fraction of the region's width per coordinate, and the last
@@ -46,7 +47,16 @@ class Objective:
 
     def __call__(self, P):
         T = Terms(self.robot, P, self.noise)
-        return lambda idx: self.of_terms(T.take(np.asarray(idx)))[0]
+
+        def fn(idx):
+            return self.of_terms(T.take(np.asarray(idx)))[0]
+
+        def lower(idx):  # the crlb objective alone: the objective adds a non-negative penalty to it
+            idx = np.asarray(idx)
+            return crlb_objective_batch({"aq": T.aq[idx], "v": T.v[idx]}, self.sm2, self.w)
+
+        fn.lower = lower
+        return fn
 
     def of_terms(self, d):
         """``(objective, crlb objective, shortfall)`` of B designs from :meth:`Terms.take` (B, K, ...)."""
