@@ -55,7 +55,13 @@ class _Calls:
         if cols is None:
             from zerocal_sym.model.fastcall import Columns
 
-            cols = self._cols[name] = Columns(self._funcs[name], self.PER_POSE[name])
+            f = self._funcs[name]
+            try:
+                cols = Columns(f, self.PER_POSE[name])
+            except ValueError:  # an output that is not a dense column (a mechanism of one's own): the plain call
+                def cols(*a, f=f):
+                    return [o.full() for o in f.call(list(a))]
+            self._cols[name] = cols
         return cols(*args)
 
 

@@ -103,15 +103,15 @@ def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
             xv = getattr(Tx, key)
             d[key][rows, which] = xv[:ns]
             d[key][ns:] = xv[ns:].reshape((POLISH_RANDOM, K) + xv.shape[1:])
-        feas = np.concatenate([ok[:ns], ok[ns:].reshape(POLISH_RANDOM, K).all(axis=1)])
-        o = fn.of_terms(d)[0]
-        o[~feas | ~_window_ok(d["rho"], cons)] = np.inf
+        keep = np.concatenate([ok[:ns], ok[ns:].reshape(POLISH_RANDOM, K).all(axis=1)]) & _window_ok(d["rho"], cons)
         if cons.min_separation_mm > 0:
             designs = np.concatenate([np.repeat(P[None], ns, axis=0), whole])
             designs[rows, which] = single
-            o[_closest(robot, designs) < cons.min_separation_mm] = np.inf
+            keep &= ~(_closest(robot, designs) < cons.min_separation_mm)
+        thr = cur - 1e-12 * max(abs(cur), 1.0)
+        o = _objectives(fn, d, keep, thr)
         k = int(np.argmin(o))
-        if o[k] < cur - 1e-12 * max(abs(cur), 1.0):
+        if o[k] < thr:
             P = designs[k].copy() if cons.min_separation_mm > 0 else _design_of(k, P, single, which, whole)
             T = Terms(robot, P, fn.noise)
             cur = o[k]
@@ -119,6 +119,19 @@ def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
         else:
             step /= 2
     return P, float(cur)
+
+
+def _objectives(fn: Objective, d: dict, keep, thr):
+    """The penalised objective of the trial designs ``d`` (:meth:`Terms.take`, B designs) that ``keep`` selects
+    and whose crlb objective (a lower bound: the penalty is not negative) is below ``thr``; inf for the others,
+    shape (B,).  A design left out can neither improve on ``thr`` nor be the least of those that do."""
+    o = np.full(len(keep), np.inf)
+    sel = np.flatnonzero(keep)
+    if len(sel):
+        sel = sel[crlb_objective_batch({"aq": d["aq"][sel], "v": d["v"][sel]}, fn.sm2, fn.w) < thr]
+    if len(sel):
+        o[sel] = fn.of_terms({k_: v[sel] for k_, v in d.items()})[0]
+    return o
 
 
 def _design_of(k, P, single, which, whole):
