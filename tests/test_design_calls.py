@@ -72,6 +72,11 @@ def test_pose_terms_and_kinematics_are_the_plain_calls(robot):
 
     ok = np.all(np.isfinite(th), axis=1)
     assert np.array_equal(dcalls.fk(robot, th[ok]), kin.fk(robot, th[ok]), equal_nan=True)
+    # the terms with the forward kinematics of their joints, in one Function: the same numbers as both apart
+    fused = dcalls.calls(robot)("design_pose_terms_fk", P.T, robot.geometry)
+    for a, o in zip(fused[:-1], out):
+        assert np.array_equal(a, o.full(), equal_nan=True)
+    assert np.array_equal(fused[-1].T[ok], kin.fk(robot, th[ok]), equal_nan=True)
 
 
 @pytest.mark.parametrize("region", ["workspace", "reachable"])

@@ -21,8 +21,8 @@ from functools import lru_cache
 import numpy as np
 
 #: the Functions of a mechanism are compiled when their instructions add up to at most this many (the planar
-#: robot's 464, the rotary Delta's 1945; the hexapod's forward kinematics alone has 8947 and its design terms
-#: 58588: a build of minutes, left interpreted)
+#: robot's about 900, the rotary Delta's about 4000; the hexapod's forward kinematics alone has 8947 and its
+#: design terms 58588: a build of minutes, left interpreted)
 COMPILE_MAX_INSTRUCTIONS = 10000
 
 
@@ -30,7 +30,8 @@ class _Calls:
     """The per-pose Functions of one mechanism and identified set, each callable over N poses."""
 
     #: name -> which inputs are per pose (the others, the geometry, shared)
-    PER_POSE = {"design_pose_terms": (True, False), "ik": (True, False), "fk": (True, False)}
+    PER_POSE = {"design_pose_terms": (True, False), "design_pose_terms_fk": (True, False), "ik": (True, False),
+                "fk": (True, False)}
 
     def __init__(self, mech_name: str, params: tuple):
         from zerocal_sym.design.terms import _pose_terms_fn
@@ -38,7 +39,9 @@ class _Calls:
         from zerocal_sym.model.mechanism import get_mechanism
 
         mech = get_mechanism(mech_name)
-        funcs = {"design_pose_terms": _pose_terms_fn(mech_name, params), "ik": mech["ik"], "fk": mech["fk"]}
+        terms = _pose_terms_fn(mech_name, params)
+        funcs = {"design_pose_terms": terms, "design_pose_terms_fk": _with_fk(terms, mech["fk"]), "ik": mech["ik"],
+                 "fk": mech["fk"]}
         self.tier = None
         if (len({f.name() for f in funcs.values()}) == len(funcs)
                 and sum(f.n_instructions() for f in funcs.values()) <= COMPILE_MAX_INSTRUCTIONS):
@@ -63,6 +66,17 @@ class _Calls:
                     return [o.full() for o in f.call(list(a))]
             self._cols[name] = cols
         return cols(*args)
+
+
+def _with_fk(terms, fk):
+    """The design terms and, last, the forward kinematics of their joints (the reachable set's check that the
+    model's assembly mode returns the pose) in one Function: the same expressions, the same numbers."""
+    import casadi as ca
+
+    P, g = ca.SX.sym("P", terms.size1_in(0)), ca.SX.sym("g", terms.size1_in(1))
+    out = terms(P, g)
+    return ca.Function("design_pose_terms_fk", [P, g], list(out) + [fk(out[0], g)], ["P", "g"],
+                       [terms.name_out(i) for i in range(terms.n_out())] + ["fk"])
 
 
 @lru_cache(maxsize=None)

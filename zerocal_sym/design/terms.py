@@ -216,8 +216,11 @@ def pose_terms(robot, P) -> dict:
     from zerocal_sym.design.calls import calls
 
     P = np.atleast_2d(np.asarray(P, float))
-    K = len(P)
-    out = calls(robot)("design_pose_terms", P.T, robot.geometry)
+    return terms_dict(calls(robot)("design_pose_terms", P.T, robot.geometry), len(P))
+
+
+def terms_dict(out, K: int) -> dict:
+    """The design terms of K poses from the outputs of :func:`_pose_terms_fn` over their columns (rows, K)."""
     res = {nm: o.T.reshape(K, -1) for nm, o in zip(TERM_NAMES, out)}
     res["rho"] = res["rho"][:, 0]
     return res
