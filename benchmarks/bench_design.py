@@ -169,7 +169,8 @@ def cli_commands(passes, baseline=None):
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    cmds = {k: [sys.executable, "-m", "zerocal_sym"] + v for k, v in COMMANDS.items()}
+    # -P: the working folder not first on sys.path (the package is the installed one, or PYTHONPATH's)
+    cmds = {k: [sys.executable, "-P", "-m", "zerocal_sym"] + v for k, v in COMMANDS.items()}
     with tempfile.TemporaryDirectory(prefix="bench-design-") as tmp:
         if baseline:
             arch = subprocess.run(["git", "-C", str(root), "archive", baseline, "zerocal_sym"], capture_output=True)
@@ -177,7 +178,7 @@ def cli_commands(passes, baseline=None):
                 raise SystemExit(f"git archive {baseline}: {arch.stderr.decode().strip()}")
             subprocess.run(["tar", "-x", "-C", tmp], input=arch.stdout, check=True)
             for k, v in COMMANDS.items():
-                cmds[f"{k} @{baseline}"] = ["env", f"PYTHONPATH={tmp}", sys.executable, "-m", "zerocal_sym"] + v
+                cmds[f"{k} @{baseline}"] = ["env", f"PYTHONPATH={tmp}", sys.executable, "-P", "-m", "zerocal_sym"] + v
         env_py = os.environ.pop("PYTHONPATH", None)
         try:
             t = commands(cmds, passes, warmup=True, cwd=str(root))

@@ -2,7 +2,7 @@
 
 * the per-pose Functions over N poses in chunks (model.fastcall.Columns, design.calls): the numbers of one
   call of the Function on all the poses, for every N and every mechanism, interpreted and compiled;
-* the feasibility check's terms of the feasible poses (constraints._pointwise): those pose_terms gives;
+* the feasibility check's terms of the feasible poses (design.feasible): those pose_terms gives;
 * the exchange's and the checked polish's bound (a lower bound of the objective, the trials it rules out
   not evaluated): the same choice as with every trial evaluated.
 
@@ -13,7 +13,8 @@ import pytest
 
 from zerocal_sym import design
 from zerocal_sym.design import calls as dcalls
-from zerocal_sym.design.constraints import _pointwise, _pointwise_ok
+from zerocal_sym.design.constraints import _pointwise_ok
+from zerocal_sym.design.feasible import _pointwise
 from zerocal_sym.design.exchange import _trials
 from zerocal_sym.design.terms import TERM_NAMES, pose_terms, pose_terms_fn
 from zerocal_sym.model import compiled

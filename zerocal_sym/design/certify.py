@@ -28,7 +28,8 @@ import math
 
 import numpy as np
 
-from zerocal_sym.design.constraints import _pointwise, _pointwise_ok, take_terms
+from zerocal_sym.design.constraints import _pointwise_ok
+from zerocal_sym.design.feasible import _pointwise, take_terms
 from zerocal_sym.design.posemodel import E_Q, PoseModel, _crit, _sens
 
 #: rounds of (search, solve again) per window
@@ -152,7 +153,7 @@ def _neighbour_pairs(U, radius):
 
 class _Rows:
     """The design terms of rows of a batch of poses, filled as their feasibility is checked (the terms of the
-    feasible ones, :func:`~zerocal_sym.design.constraints._pointwise`)."""
+    feasible ones, :func:`~zerocal_sym.design.feasible._pointwise`)."""
 
     def __init__(self, N, ok, t):
         self.N, self.t = N, None

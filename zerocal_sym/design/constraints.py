@@ -43,6 +43,7 @@ from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 from zerocal_sym.model.kinematics import fmt_user_pose
 from zerocal_sym.design.calls import fk
+from zerocal_sym.design.feasible import _pointwise
 from zerocal_sym.design.terms import (_call_ik, _reachable, pose_distances, pose_terms, pose_units, poses_from_user,
                                       poses_to_user)
 from zerocal_sym.design.limits import SCALE_RANGE_MM, TRAVEL_MODES, _FEAS_TOL, DesignError, _finite
@@ -300,43 +301,6 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
 def _pointwise_ok(robot, P, cons: Constraints):
     """Per-pose feasibility (region, reach, margin, joint limits), bool shape (K,)."""
     return _pointwise(robot, P, cons)[0]
-
-
-def _pointwise(robot, P, cons: Constraints):
-    """:func:`_pointwise_ok` and the design terms of the feasible poses (those of
-    :func:`~zerocal_sym.design.terms.pose_terms` of ``P[ok]``, or None when none is), from one evaluation."""
-    P = np.atleast_2d(P)
-    ok = cons.region.contains(P, _POINT_TOL)
-    if not np.any(ok):
-        return ok, None
-    idx = np.flatnonzero(ok)
-    if cons.mode_signs is not None:
-        from zerocal_sym.design.regions import _feasible_terms
-
-        jl = cons.joint_limits_internal()
-        good, t = _feasible_terms(robot, P[ok], cons.singularity_margin, jl, np.asarray(cons.mode_signs))
-    else:
-        t = pose_terms(robot, P[ok])
-        good = _reachable(t["ratio"], t["theta"], 1e-9)
-        sel = np.flatnonzero(good)
-        if len(sel):
-            sub = np.min(np.abs(t["s"][sel]), axis=1) >= cons.singularity_margin + 1e-9
-            if cons.joint_limits is not None:
-                jl = cons.joint_limits_internal()
-                theta = t["theta"][sel]
-                sub &= np.all((theta >= jl[:, 0] + 1e-9) & (theta <= jl[:, 1] - 1e-9), axis=1)
-            good[sel] = sub
-            sel = sel[sub]
-        t = take_terms(t, sel)
-    ok[idx] = good
-    return ok, (t if np.any(good) else None)
-
-
-def take_terms(t: dict, keep) -> dict:
-    """The design terms (:func:`~zerocal_sym.design.terms.pose_terms`) of the poses ``keep`` selects (bool or
-    indices), laid out as ``pose_terms`` lays them out (each (K, r) array column-major), so that what is computed
-    from them is what ``pose_terms`` of those poses would give, bit for bit."""
-    return {k: (v[keep] if v.ndim == 1 else np.asfortranarray(v[keep])) for k, v in t.items()}
 
 
 def _feasible_random_subset(rng, rho, K, cons, tries=200, close=None):

@@ -91,7 +91,7 @@ class PoseModel:
         Weight of a linear criterion (None for D and E).
 
     ``terms``: :func:`~zerocal_sym.design.terms.pose_terms` of ``X`` if already computed (as the feasibility
-    check returns them, :func:`~zerocal_sym.design.constraints._pointwise`).
+    check returns them, :func:`~zerocal_sym.design.feasible._pointwise`).
     """
 
     def __init__(self, robot, X, noise, criterion, weights: Weights | None = None, terms: dict | None = None):

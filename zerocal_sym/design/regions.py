@@ -308,46 +308,11 @@ class ReachableRegion(CentredBox):
 
 
 def _feasible(robot, P, margin, jl_rad, signs):
-    """Per-pose feasibility of the reachable set (no clip), bool shape (K,)."""
-    return _feasible_terms(robot, P, margin, jl_rad, signs)[0]
+    """Per-pose feasibility of the reachable set (no clip), bool shape (K,)
+    (:func:`zerocal_sym.design.feasible.reachable_terms`)."""
+    from zerocal_sym.design.feasible import reachable_terms
 
-
-def _feasible_terms(robot, P, margin, jl_rad, signs):
-    """:func:`_feasible` and the design terms of the feasible poses (:func:`zerocal_sym.design.constraints.take_terms`),
-    from one evaluation of the terms."""
-    from zerocal_sym.design.calls import calls, fk, ik
-    from zerocal_sym.design.constraints import take_terms
-    from zerocal_sym.design.terms import _reachable, pose_terms, terms_dict
-
-    P = np.atleast_2d(P)
-    if len(P) <= FUSED_MAX:  # one call: the terms and the forward kinematics of every pose
-        out = calls(robot)("design_pose_terms_fk", P.T, robot.geometry)
-        t, back = terms_dict(out[:-1], len(P)), np.ascontiguousarray(out[-1].T)
-        ok = _reachable(t["ratio"], t["theta"], 1e-9)
-    else:  # a grid, many poses out of reach: the inverse kinematics first, the terms of the reachable poses
-        ok = _reachable(*ik(robot, P)[::-1], 1e-9)
-    idx = np.flatnonzero(ok)
-    if not len(idx):
-        return ok, None
-    if len(P) <= FUSED_MAX:
-        s, theta, back = t["s"][idx], t["theta"][idx], back[idx]
-    else:
-        t = pose_terms(robot, P[idx])
-        s, theta = t["s"], t["theta"]
-        back = fk(robot, theta)
-    good = np.min(s * signs, axis=1) >= margin + 1e-9
-    if jl_rad is not None:
-        good &= np.all((theta >= jl_rad[:, 0] + 1e-9) & (theta <= jl_rad[:, 1] - 1e-9), axis=1)
-    good &= np.linalg.norm(back - P[idx], axis=1) < 1e-6
-    ok[idx] = good
-    if not np.any(good):
-        return ok, None
-    return ok, take_terms(t, idx[good] if len(P) <= FUSED_MAX else good)
-
-
-#: :func:`_feasible_terms` of up to this many poses in one call (the terms and the forward kinematics of each);
-#: of more (a grid over a box, many poses out of reach) the terms of the reachable ones only
-FUSED_MAX = 4096
+    return reachable_terms(robot, P, margin, jl_rad, signs)[0]
 
 
 def mode_signs(robot) -> np.ndarray:
