@@ -12,16 +12,27 @@ pass: benchmarks/_harness.py), CPU time (this process) beside wall time, the loa
   Ipopt start of the same NLP; the CPU seconds of each stage (the certificate's approximate design, the
   exchange, the Ipopt starts and polish) and Ipopt's own split (its function evaluations against the rest).
   Target: under 1 s of CPU;
+* default (the default criterion): ``zerocal design --optimize --K 6`` (``checked``: the least CRLB among
+  designs whose fit check sees what they assume; the paper's robot, its workspace) in this process, against
+  the crlb design of the same region (the first half of it);
+* commands (``--no-commands`` skips them): the two commands above as the CLI runs them, each a fresh process
+  (imports, the region, the design, the report), interleaved with the same commands run by the package of an
+  earlier commit (``--baseline``, default :data:`DESIGN_BASELINE`, before the design's time was cut; the
+  same interpreter and libraries); CPU of the process (user + system) and the ratio in the same pass;
 * extras (``--no-extras`` skips them): K = 100 designs (the approximate method) on the paper's robot and the
   Delta, and ``--target-crlb 0.04`` (the fewest poses): one run each, CPU and wall.
 
+The design's per-pose Functions run on the compiled tier once hot (``ZEROCAL_COMPILE``, default ``auto``: a
+library in the cache loads at once, else one is built in the background and used when ready); the load and the
+tier's state are printed with the figures.
+
 Usage: python benchmarks/bench_design.py [--passes 3] [--K 6 20] [--criteria crlb cond] [--starts 8]
-                                         [--only-extras] [--no-extras] [--json]
+                                         [--only-extras] [--no-extras] [--no-commands] [--baseline REV] [--json]
 """
 import argparse
 import time
 
-from _harness import emit, interleaved, load, load_line, median, ratio, summary
+from _harness import commands, emit, interleaved, load, load_line, median, ratio, summary
 
 TARGET_CPU_S = 1.0
 
@@ -111,6 +122,86 @@ def reachable(passes):
             "method": d["method"]}
 
 
+def default_checked(passes):
+    """``zerocal design --optimize --K 6`` (criterion ``checked``) in this process, against the crlb design."""
+    from zerocal_sym import design
+    from zerocal_sym.model.noise import NoiseModel
+    from zerocal_sym.model.robot import paper_robot
+
+    robot, noise = paper_robot(), NoiseModel.paper()
+    cons = design.make_constraints(robot)
+    out = {}
+
+    def run(crit):
+        def go():
+            out[crit] = design.optimize_design(robot, 6, crit, cons, noise, seed=0)
+            return 1
+        return go
+
+    t = interleaved({"checked (default)": run("checked"), "crlb": run("crlb")}, passes)
+    d = out["checked"].to_dict()
+    return {"columns": summary(t, "s"), "checked_cpu_s": median(t, "checked (default)"),
+            "checked_wall_s": median(t, "checked (default)", "wall"), "crlb_cpu_s": median(t, "crlb"),
+            "checked_over_crlb_cpu": ratio(t, "checked (default)", "crlb"), "crlb_rms_deg": d["crlb_rms_deg"],
+            "method": d["method"], "meets": (d.get("detection") or {}).get("meets"),
+            "stages_wall_s": out["checked"].timing}
+
+
+#: the commands of the target and of the default criterion, as the CLI runs them
+COMMANDS = {"crlb, reachable": ["design", "--optimize", "--K", "6", "--criterion", "crlb", "--region", "reachable",
+                                "--bounds", "-2000", "2000", "450", "2000"],
+            "checked (default)": ["design", "--optimize", "--K", "6"]}
+
+
+#: the baseline of ``--baseline``: the commit before the design's time was cut (its package run with this
+#: interpreter and these libraries)
+DESIGN_BASELINE = "e77060d"
+
+
+def cli_commands(passes, baseline=None):
+    """The commands of :data:`COMMANDS`, each a fresh process, interleaved: CPU (user + system) and wall; with
+    ``baseline`` (a commit) each also with that commit's package (``git archive`` of ``zerocal_sym`` first on
+    ``PYTHONPATH``), and the ratio of their CPU times in the same pass."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    # -P: the working folder not first on sys.path (the package is the installed one, or PYTHONPATH's)
+    cmds = {k: [sys.executable, "-P", "-m", "zerocal_sym"] + v for k, v in COMMANDS.items()}
+    with tempfile.TemporaryDirectory(prefix="bench-design-") as tmp:
+        if baseline:
+            arch = subprocess.run(["git", "-C", str(root), "archive", baseline, "zerocal_sym"], capture_output=True)
+            if arch.returncode != 0:
+                raise SystemExit(f"git archive {baseline}: {arch.stderr.decode().strip()}")
+            subprocess.run(["tar", "-x", "-C", tmp], input=arch.stdout, check=True)
+            for k, v in COMMANDS.items():
+                cmds[f"{k} @{baseline}"] = ["env", f"PYTHONPATH={tmp}", sys.executable, "-P", "-m", "zerocal_sym"] + v
+        env_py = os.environ.pop("PYTHONPATH", None)
+        try:
+            t = commands(cmds, passes, warmup=True, cwd=str(root))
+        finally:
+            if env_py is not None:
+                os.environ["PYTHONPATH"] = env_py
+    out = {"columns": summary(t, "s"), "argv": {k: "zerocal " + " ".join(v) for k, v in COMMANDS.items()}}
+    if baseline:
+        out["baseline"] = baseline
+        out["over_baseline_cpu"] = {k: ratio(t, k, f"{k} @{baseline}") for k in COMMANDS}
+    return out
+
+
+def tier_state():
+    """What the compiled tier did in this process (the design's Functions: loaded, built, or interpreted)."""
+    import os
+
+    from zerocal_sym.model import compiled
+
+    return {"ZEROCAL_COMPILE": os.environ.get("ZEROCAL_COMPILE", "auto"),
+            "design_events": [e for _, k, e in compiled.status() if k.startswith("design-")]}
+
+
 def table(a):
     from zerocal_sym import design
     from zerocal_sym.design import nlp as design_nlp
@@ -192,14 +283,21 @@ def main():
                     help="only the reachable case and the extra cases")
     ap.add_argument("--no-extras", dest="no_extras", action="store_true",
                     help="skip the extra cases (K = 100, fewest poses)")
+    ap.add_argument("--no-commands", action="store_true", help="skip the commands run as fresh processes")
+    ap.add_argument("--baseline", default=DESIGN_BASELINE,
+                    help=f"commit whose package runs the commands too (default {DESIGN_BASELINE}; '' for none)")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     a = ap.parse_args()
     res = {"load_before": load(), "passes": a.passes}
     res["reachable_K6"] = reachable(a.passes)
+    res["default_K6"] = default_checked(a.passes)
+    if not a.no_commands:
+        res["commands"] = cli_commands(a.passes, a.baseline or None)
     if not a.only_extras:
         res["table"] = table(a)
     if not a.no_extras:
         res["extras"] = extras()
+    res["compiled_tier"] = tier_state()
     res["load_after"] = load()
     if emit(res, a.json):
         return
@@ -215,6 +313,19 @@ def main():
     print("  poses (mm): " + "; ".join(f"({x:.1f}, {y:.1f})" for x, y in r["poses_mm"]))
     print("  stages, CPU s: " + ", ".join(f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}"
                                           for k, v in r["stages_cpu_s"].items()))
+    dft = res["default_K6"]
+    print(f"workspace, K = 6, checked (the default): {dft['checked_cpu_s']:.2f} s CPU ({dft['checked_wall_s']:.2f} s "
+          f"wall), {dft['checked_over_crlb_cpu']:.2f} x the crlb design ({dft['crlb_cpu_s']:.2f} s CPU); CRLB "
+          f"{dft['crlb_rms_deg']:.5f} deg; {dft['method']}; fit check meets the requirement: {dft['meets']}")
+    cm = res.get("commands", {})
+    for name, argv in cm.get("argv", {}).items():
+        c = cm["columns"][name]
+        line = f"  `{argv}` (a fresh process): {c['cpu_s']:.2f} s CPU ({c['wall_s']:.2f} s wall)"
+        if cm.get("baseline"):
+            b = cm["columns"][f"{name} @{cm['baseline']}"]
+            line += (f"; at {cm['baseline']} {b['cpu_s']:.2f} s CPU ({b['wall_s']:.2f} s wall): "
+                     f"{cm['over_baseline_cpu'][name]:.2f} x in CPU")
+        print(line)
     for row in res.get("table", []):
         c = row["columns"]
         print(f"K = {row['K']:3d} {row['criterion']:>5s}: design {c['design']['cpu_s']:.2f} s CPU "
@@ -227,6 +338,9 @@ def main():
         rest = ", ".join(f"{k} {v:.5g}" if isinstance(v, float) else f"{k} {v}"
                          for k, v in e.items() if k not in ("case", "cpu_s", "wall_s"))
         print(f"{e['case']}: {e['cpu_s']:.2f} s CPU ({e['wall_s']:.2f} s wall); {rest}")
+    tier = res["compiled_tier"]
+    print(f"compiled tier (ZEROCAL_COMPILE={tier['ZEROCAL_COMPILE']}): "
+          + ("; ".join(tier["design_events"]) or "the design's Functions interpreted"))
     print(load_line(res["load_before"], res["load_after"]))
 
 

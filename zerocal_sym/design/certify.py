@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from zerocal_sym.design.constraints import _pointwise_ok
+from zerocal_sym.design.feasible import _pointwise, take_terms
 from zerocal_sym.design.posemodel import E_Q, PoseModel, _crit, _sens
 
 #: rounds of (search, solve again) per window
@@ -94,9 +95,9 @@ class Sensitivity:
         self.c = sol["c"]
         _, self.G, self.s = _crit(criterion, sol["M"], W, sol.get("q", E_Q))
 
-    def __call__(self, Y):
-        """``(d / s, rho)`` at poses ``Y`` (M, n)."""
-        m = PoseModel(self.robot, Y, self.noise, self.criterion, self.weights)
+    def __call__(self, Y, terms=None):
+        """``(d / s, rho)`` at poses ``Y`` (M, n) (``terms``: their design terms, if at hand)."""
+        m = PoseModel(self.robot, Y, self.noise, self.criterion, self.weights, terms)
         return _sens(self.G, m.aq, self.c, m.vt) / self.s, m.rho
 
 
@@ -150,6 +151,27 @@ def _neighbour_pairs(U, radius):
     return I[keep], J[keep], D[keep]
 
 
+class _Rows:
+    """The design terms of rows of a batch of poses, filled as their feasibility is checked (the terms of the
+    feasible ones, :func:`~zerocal_sym.design.feasible._pointwise`)."""
+
+    def __init__(self, N, ok, t):
+        self.N, self.t = N, None
+        self.put(np.flatnonzero(ok), t)
+
+    def put(self, rows, t):
+        if t is None or not len(rows):
+            return
+        if self.t is None:
+            self.t = {k: np.empty((self.N,) + v.shape[1:]) for k, v in t.items()}
+        for k, v in t.items():
+            self.t[k][rows] = v
+
+    def of(self, ok):
+        """The terms of the rows ``ok`` (bool), laid out as :func:`~zerocal_sym.design.terms.pose_terms`'s."""
+        return take_terms(self.t, ok)
+
+
 def maximise(robot, cons, sens: Sensitivity, X0, h, window):
     """Pattern search for the largest ``d / s`` from each start ``X0`` (S, n) over the feasible poses with
     ``rho`` in ``window``; returns ``(X (S, n), r (S,))``."""
@@ -165,7 +187,8 @@ def maximise(robot, cons, sens: Sensitivity, X0, h, window):
         a = np.flatnonzero(active)
         base = np.repeat(X[a], len(dirs), axis=0)
         Y = (X[a, None, :] + step[a, None, None] * dirs[None] * hs).reshape(-1, n)
-        ok = _pointwise_ok(robot, Y, cons)
+        ok, t = _pointwise(robot, Y, cons)
+        terms = _Rows(len(Y), ok, t)
         # a move that leaves the feasible set goes as far along it as feasible (halving back, BACKTRACK times):
         # at a curved boundary (the singularity margin, the reach) it slides along it
         for _ in range(BACKTRACK):
@@ -173,10 +196,11 @@ def maximise(robot, cons, sens: Sensitivity, X0, h, window):
             if not len(bad):
                 break
             Y[bad] = 0.5 * (Y[bad] + base[bad])
-            ok[bad] = _pointwise_ok(robot, Y[bad], cons)
+            ok[bad], t = _pointwise(robot, Y[bad], cons)
+            terms.put(bad[ok[bad]], t)
         ry = np.full(len(Y), -np.inf)
         if np.any(ok):
-            val, rho = sens(Y[ok])
+            val, rho = sens(Y[ok], terms.of(ok))
             val[(rho < window[0]) | (rho > window[1])] = -np.inf
             ry[ok] = val
         ry = ry.reshape(len(a), len(dirs))

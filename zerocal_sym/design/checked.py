@@ -21,7 +21,8 @@ import numpy as np
 from zerocal_sym.design.certify import directions
 from zerocal_sym.design.constraints import Constraints, _pointwise_ok, check_design
 from zerocal_sym.design.criteria import _noise_terms
-from zerocal_sym.design.detection import ORDER_MARGIN, PENALTY, Requirement, Terms, detection, evaluate_batch
+from zerocal_sym.design.detection import (ORDER_MARGIN, PENALTY, Requirement, Terms, crlb_objective_batch,
+                                          detection, evaluate_batch)
 from zerocal_sym.design.terms import _crlb_weights, offset_positions
 
 #: pattern search: the first step as a fraction of the region's width per coordinate, and the last
@@ -46,7 +47,16 @@ class Objective:
 
     def __call__(self, P):
         T = Terms(self.robot, P, self.noise)
-        return lambda idx: self.of_terms(T.take(np.asarray(idx)))[0]
+
+        def fn(idx):
+            return self.of_terms(T.take(np.asarray(idx)))[0]
+
+        def lower(idx):  # the crlb objective alone: the objective adds a non-negative penalty to it
+            idx = np.asarray(idx)
+            return crlb_objective_batch({"aq": T.aq[idx], "v": T.v[idx]}, self.sm2, self.w)
+
+        fn.lower = lower
+        return fn
 
     def of_terms(self, d):
         """``(objective, crlb objective, shortfall)`` of B designs from :meth:`Terms.take` (B, K, ...)."""
@@ -93,15 +103,15 @@ def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
             xv = getattr(Tx, key)
             d[key][rows, which] = xv[:ns]
             d[key][ns:] = xv[ns:].reshape((POLISH_RANDOM, K) + xv.shape[1:])
-        feas = np.concatenate([ok[:ns], ok[ns:].reshape(POLISH_RANDOM, K).all(axis=1)])
-        o = fn.of_terms(d)[0]
-        o[~feas | ~_window_ok(d["rho"], cons)] = np.inf
+        keep = np.concatenate([ok[:ns], ok[ns:].reshape(POLISH_RANDOM, K).all(axis=1)]) & _window_ok(d["rho"], cons)
         if cons.min_separation_mm > 0:
             designs = np.concatenate([np.repeat(P[None], ns, axis=0), whole])
             designs[rows, which] = single
-            o[_closest(robot, designs) < cons.min_separation_mm] = np.inf
+            keep &= ~(_closest(robot, designs) < cons.min_separation_mm)
+        thr = cur - 1e-12 * max(abs(cur), 1.0)
+        o = _objectives(fn, d, keep, thr)
         k = int(np.argmin(o))
-        if o[k] < cur - 1e-12 * max(abs(cur), 1.0):
+        if o[k] < thr:
             P = designs[k].copy() if cons.min_separation_mm > 0 else _design_of(k, P, single, which, whole)
             T = Terms(robot, P, fn.noise)
             cur = o[k]
@@ -109,6 +119,19 @@ def polish(robot, P, cons: Constraints, fn: Objective, seed: int = 0):
         else:
             step /= 2
     return P, float(cur)
+
+
+def _objectives(fn: Objective, d: dict, keep, thr):
+    """The penalised objective of the trial designs ``d`` (:meth:`Terms.take`, B designs) that ``keep`` selects
+    and whose crlb objective (a lower bound: the penalty is not negative) is below ``thr``; inf for the others,
+    shape (B,).  A design left out can neither improve on ``thr`` nor be the least of those that do."""
+    o = np.full(len(keep), np.inf)
+    sel = np.flatnonzero(keep)
+    if len(sel):
+        sel = sel[crlb_objective_batch({"aq": d["aq"][sel], "v": d["v"][sel]}, fn.sm2, fn.w) < thr]
+    if len(sel):
+        o[sel] = fn.of_terms({k_: v[sel] for k_, v in d.items()})[0]
+    return o
 
 
 def _design_of(k, P, single, which, whole):

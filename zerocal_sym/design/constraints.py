@@ -42,6 +42,8 @@ import numpy as np
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model import units
 from zerocal_sym.model.kinematics import fmt_user_pose
+from zerocal_sym.design.calls import fk
+from zerocal_sym.design.feasible import _pointwise
 from zerocal_sym.design.terms import (_call_ik, _reachable, pose_distances, pose_terms, pose_units, poses_from_user,
                                       poses_to_user)
 from zerocal_sym.design.limits import SCALE_RANGE_MM, TRAVEL_MODES, _FEAS_TOL, DesignError, _finite
@@ -241,13 +243,12 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
     inside = r.contains(P, tol)
     for k in np.flatnonzero(~inside):
         out.append(f"pose {k} {_fp(robot, P[k])} is outside the region {r.describe()}")
-    th, ratio = _call_ik(robot, P)
-    unreach = ~_reachable(ratio, th)
+    t = pose_terms(robot, P)
+    unreach = ~_reachable(t["ratio"], t["theta"])
     for k in np.flatnonzero(unreach):
         out.append(f"pose {k} {_fp(robot, P[k])} is unreachable")
     if np.any(unreach):
         return out
-    t = pose_terms(robot, P)
     if cons.mode_signs is None:
         smin = np.min(np.abs(t["s"]), axis=1)
         for k in np.flatnonzero(smin < cons.singularity_margin - tol):
@@ -257,7 +258,7 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
         for k in np.flatnonzero(smin < cons.singularity_margin - tol):
             out.append(f"pose {k}: min signed sin transmission angle {smin[k]:.4f} < margin "
                        f"{cons.singularity_margin:g} (the home pose's modes)")
-        back = kin.fk(robot, t["theta"])
+        back = fk(robot, t["theta"])
         for k in np.flatnonzero(~(np.linalg.norm(back - P, axis=1) < 1e-6)):
             out.append(f"pose {k} {_fp(robot, P[k])}: forward kinematics gives another assembly "
                        "mode")
@@ -299,27 +300,7 @@ def check_design(robot, P, cons: Constraints, tol: float = _FEAS_TOL) -> list:
 
 def _pointwise_ok(robot, P, cons: Constraints):
     """Per-pose feasibility (region, reach, margin, joint limits), bool shape (K,)."""
-    P = np.atleast_2d(P)
-    if cons.mode_signs is not None:
-        from zerocal_sym.design.regions import _feasible
-
-        ok = cons.region.contains(P, _POINT_TOL)
-        if np.any(ok):
-            jl = cons.joint_limits_internal()
-            ok[np.flatnonzero(ok)] = _feasible(robot, P[ok], cons.singularity_margin, jl,
-                                               np.asarray(cons.mode_signs))
-        return ok
-    th, ratio = _call_ik(robot, P)
-    ok = _reachable(ratio, th, 1e-9) & cons.region.contains(P, _POINT_TOL)
-    if not np.any(ok):
-        return ok
-    t = pose_terms(robot, P[ok])
-    good = np.min(np.abs(t["s"]), axis=1) >= cons.singularity_margin + 1e-9
-    if cons.joint_limits is not None:
-        jl = cons.joint_limits_internal()
-        good &= np.all((t["theta"] >= jl[:, 0] + 1e-9) & (t["theta"] <= jl[:, 1] - 1e-9), axis=1)
-    ok[np.flatnonzero(ok)] = good
-    return ok
+    return _pointwise(robot, P, cons)[0]
 
 
 def _feasible_random_subset(rng, rho, K, cons, tries=200, close=None):

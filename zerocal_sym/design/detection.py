@@ -150,7 +150,7 @@ class Requirement:
         dof = K - 1 - p
         if dof <= 0:
             return np.full(lam.shape, SHORTFALL_CAP)
-        kinds = np.array([k for _, k, _ in pw.scenario_names(self.robot, K)])
+        kinds = pw.scenario_kinds(self.robot, K)
         with np.errstate(divide="ignore", invalid="ignore"):
             short = math.log(self.lam_required(dof)) - np.log(np.maximum(lam, 1e-300))
             if self.order_margin != 1.0:  # the first order overstates what the exact fit leaves of an order error
@@ -203,13 +203,26 @@ def evaluate_batch(robot, req: Requirement, d: dict, sm2: float, offsets, crlb_w
     delta = pw.scenario_effects(d["ao"], d["gs"], d["rho"], req.tol, req.scale_error, req.bad_reading_mm)
     lam, harm, var, order_harm = pw.noncentralities(d["aq"], d["v"], sm2, delta, offsets, req.sigma_q,
                                                     req.offset_range_q)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        o = np.log(var @ crlb_weights)  # the crlb criterion's objective (criteria._objective_fisher)
-    o[~np.isfinite(o)] = np.inf
-    kinds = np.array([k for _, k, _ in pw.scenario_names(robot, K)])
+    o = _crlb_objective(var, crlb_weights)
+    kinds = pw.scenario_kinds(robot, K)
     harm[:, kinds == "order"] = np.maximum(harm[:, kinds == "order"], order_harm)
     short = req.terms_short(lam, harm, K, p).sum(axis=1)
     return o + penalty * short, o, short, lam, harm
+
+
+def _crlb_objective(var, crlb_weights):
+    """The crlb criterion's objective (:func:`zerocal_sym.design.criteria._objective_fisher`) from ``diag(F^-1)``
+    (B, p): inf where not finite."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        o = np.log(var @ crlb_weights)
+    o[~np.isfinite(o)] = np.inf
+    return o
+
+
+def crlb_objective_batch(d: dict, sm2: float, crlb_weights):
+    """The crlb objective of :func:`evaluate_batch` alone (its ``crlb objective``, the same numbers) of B designs
+    from ``aq`` and ``v`` (B, K, ...): a lower bound of its objective, which adds a non-negative penalty."""
+    return _crlb_objective(pw.crlb_variances(d["aq"], d["v"], sm2), crlb_weights)
 
 
 #: up to this K every scenario is listed in a report; beyond, the entries and the worst order and reading

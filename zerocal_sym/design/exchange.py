@@ -29,6 +29,25 @@ def candidate_grid(robot, cons: Constraints, *grid):
     return pts[_pointwise_ok(robot, pts, cons)]
 
 
+def _trials(fn, trial, keep, cur):
+    """The objective of the trials (B, K) that ``keep`` selects, inf for the others, shape (B,).
+
+    With a lower bound (``fn.lower``, a cheaper function of the same trials, never above ``fn``) only the trials
+    whose bound is below the improvement threshold of the current objective ``cur`` are evaluated: a trial
+    left out cannot improve on ``cur``, and every trial that could be the least one, if the least improves,
+    is evaluated -- the exchange's choice (the first least trial, if it improves) is the one it makes with
+    every trial evaluated.
+    """
+    o = np.full(len(trial), np.inf)
+    sel = np.flatnonzero(keep)
+    lower = getattr(fn, "lower", None)
+    if lower is not None and len(sel):
+        sel = sel[lower(trial[sel]) < cur - 1e-10 * max(abs(cur), 1.0)]
+    if len(sel):
+        o[sel] = fn(trial[sel])
+    return o
+
+
 def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None, noise=None, seed=0,
                     n_starts: int = 8, grid=None, max_sweeps: int = 50, tolerances=None, step=None,
                     objective=None):
@@ -88,6 +107,7 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         close = pose_distances(robot, cand) < cons.min_separation_mm
         np.fill_diagonal(close, False)
     best_idx, best_o, starts = None, np.inf, []
+    seen = {}  # (design, slot) -> the best trial of that slot and its objective: the same design, the same trials
     for _ in range(n_starts):
         idx = _feasible_random_subset(rng, rho, K, cons, close=close)
         if idx is None:
@@ -97,18 +117,25 @@ def exchange_design(robot, K, criterion="crlb", cons: Constraints | None = None,
         for _sweep in range(max_sweeps):
             improved = False
             for pos in rng.permutation(K):
+                key = (idx.tobytes(), int(pos))
+                if key in seen:  # this slot of this design was tried before (an earlier sweep or start): its best
+                    k_idx, ok_ = seen[key]
+                    if ok_ < cur - 1e-10 * max(abs(cur), 1.0):
+                        idx, cur, improved = k_idx, ok_, True
+                    continue
                 free = np.setdiff1d(np.arange(N), idx)
                 trial = np.repeat(idx[None], len(free), axis=0)
                 trial[:, pos] = free
-                o = fn(trial)
+                # the objective of the trials that keep the travel and the separation (the others: inf)
                 if cons.travel_mode == "range":
-                    o[np.ptp(rho[trial], axis=1) > cons.travel_mm] = np.inf
+                    keep = ~(np.ptp(rho[trial], axis=1) > cons.travel_mm)
                 else:
-                    o[np.max(np.abs(np.diff(rho[trial], axis=1)), axis=1) > cons.travel_mm] = np.inf
+                    keep = ~(np.max(np.abs(np.diff(rho[trial], axis=1)), axis=1) > cons.travel_mm)
                 if close is not None:
-                    others = np.delete(idx, pos)
-                    o[np.any(close[np.ix_(free, others)], axis=1)] = np.inf
+                    keep &= ~np.any(close[np.ix_(free, np.delete(idx, pos))], axis=1)
+                o = _trials(fn, trial, keep, cur)
                 k = int(np.argmin(o))
+                seen[key] = (trial[k], o[k])
                 if o[k] < cur - 1e-10 * max(abs(cur), 1.0):
                     idx, cur, improved = trial[k], o[k], True
             if not improved:

@@ -89,12 +89,15 @@ class PoseModel:
     rho : ndarray, shape (N,)
     W : ndarray, shape (p, p) or None
         Weight of a linear criterion (None for D and E).
+
+    ``terms``: :func:`~zerocal_sym.design.terms.pose_terms` of ``X`` if already computed (as the feasibility
+    check returns them, :func:`~zerocal_sym.design.feasible._pointwise`).
     """
 
-    def __init__(self, robot, X, noise, criterion, weights: Weights | None = None):
+    def __init__(self, robot, X, noise, criterion, weights: Weights | None = None, terms: dict | None = None):
         sm2, sx2 = _noise_terms(noise, robot)
         self.X = np.atleast_2d(np.asarray(X, float))
-        t = pose_terms(robot, self.X)
+        t = pose_terms(robot, self.X) if terms is None else terms
         self.aq = t["a"] * _qscale(robot)
         self.vt = sx2 * np.sum(t["dth"] ** 2, axis=1) + sm2 / 4.0
         self.vt = np.maximum(self.vt, 1e-12 * max(float(self.vt.max()), 1e-300))

@@ -35,6 +35,7 @@ What a checked design must see is :mod:`zerocal_sym.design.detection`'s (its :cl
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -160,6 +161,14 @@ def order_permutations(K: int):
         yield f"swap{j}", f"poses {j} and {j + 1} visited in each other's place", pi
 
 
+@lru_cache(maxsize=None)
+def order_matrix(K: int) -> np.ndarray:
+    """The permutations of :func:`order_permutations` as rows, shape (S_o, K) (read-only, made once per K)."""
+    out = np.array([pi for _, _, pi in order_permutations(K)])
+    out.setflags(write=False)
+    return out
+
+
 def scenario_names(robot, K: int) -> list:
     """``(name, kind, description)`` of every scenario of a K-pose design, the columns of :func:`scenario_effects`.
 
@@ -168,10 +177,29 @@ def scenario_names(robot, K: int) -> list:
     """
     from zerocal_sym.design.terms import omitted_params
 
-    out = [(n, "entry", f"robot-file entry {n} off by its tolerance") for n in omitted_params(robot)]
+    return list(_scenario_names(tuple(omitted_params(robot)), K))
+
+
+def scenario_kinds(robot, K: int) -> np.ndarray:
+    """The kind of each scenario of :func:`scenario_names`, shape (S,) (read-only)."""
+    from zerocal_sym.design.terms import omitted_params
+
+    return _scenario_kinds(tuple(omitted_params(robot)), K)
+
+
+@lru_cache(maxsize=None)
+def _scenario_names(omitted: tuple, K: int) -> tuple:
+    out = [(n, "entry", f"robot-file entry {n} off by its tolerance") for n in omitted]
     out.append(("scale", "entry", "every length of the robot file off by the same fraction"))
     out += [(nm, "order", d) for nm, d, _ in order_permutations(K)]
     out += [(f"reading{k + 1}", "reading", f"one bad reading (the change into pose {k})") for k in range(K - 1)]
+    return tuple(out)
+
+
+@lru_cache(maxsize=None)
+def _scenario_kinds(omitted: tuple, K: int) -> np.ndarray:
+    out = np.array([k for _, k, _ in _scenario_names(omitted, K)])
+    out.setflags(write=False)
     return out
 
 
@@ -191,7 +219,7 @@ def scenario_effects(ao, gs, rho, tol, scale_error: float, bad_reading_mm: float
     """
     B, K, _ = ao.shape
     ent = np.diff(ao, axis=1) * tol
-    perms = np.array([pi for _, _, pi in order_permutations(K)])  # (S_o, K)
+    perms = order_matrix(K)  # (S_o, K)
     orders = np.diff(rho[:, perms.T], axis=1) - np.diff(rho, axis=1)[:, :, None]  # (B, K-1, S_o)
     bad = np.broadcast_to(bad_reading_mm * np.eye(K - 1), (B, K - 1, K - 1))
     return np.concatenate([ent, scale_error * np.diff(gs, axis=1)[:, :, None], orders, bad], axis=2)
@@ -218,6 +246,33 @@ def _whiten_batch(v, sm2, *Ys):
             W[:, k] = (Y[:, k] - sub[:, k - 1, None] * W[:, k - 1]) / ell[:, k, None]
         out.append(W)
     return out
+
+
+def _factor(aq, v, sm2, *Ys):
+    """The whitened differences ``L^-1 D aq`` of B designs factored, ``(Q, R, ok, [L^-1 Y for Y in Ys])``; ``ok``
+    (B,): the designs whose ``R`` is of full rank."""
+    Aw, *W = _whiten_batch(v, sm2, np.diff(aq, axis=1), *Ys)
+    Q, R = np.linalg.qr(Aw)
+    d = np.abs(np.diagonal(R, axis1=1, axis2=2))
+    ok = d.min(axis=1) > 1e-12 * np.maximum(d.max(axis=1), 1e-300)
+    return Q, R, ok, W
+
+
+def _variances(aq, R, ok):
+    """``diag(F^-1)`` of B designs from their ``R`` (inf where not ``ok``), shape (B, p), and ``R[ok]^-1``."""
+    var = np.full(aq.shape[::2], np.inf)
+    Rinv = None
+    if np.any(ok):
+        Rinv = np.linalg.inv(R[ok])
+        var[ok] = np.sum(Rinv ** 2, axis=2)  # diag((R^T R)^-1) = diag(F^-1)
+    return var, Rinv
+
+
+def crlb_variances(aq, v, sm2):
+    """The diagonal of ``F^-1`` of B designs (:func:`noncentralities`' ``var``, the same numbers, without the
+    scenarios), shape (B, p)."""
+    _, R, ok, _ = _factor(aq, v, sm2)
+    return _variances(aq, R, ok)[0]
 
 
 def noncentralities(aq, v, sm2, delta, offsets, sigma=None, offset_range=None):
@@ -257,25 +312,20 @@ def noncentralities(aq, v, sm2, delta, offsets, sigma=None, offset_range=None):
         ``G`` = the mirror less the identity; a swap of two replicates: ``G`` = 0).
     """
     K = aq.shape[1]
-    perms = np.array([pi for _, _, pi in order_permutations(K)]) if offset_range is not None else None
+    perms = order_matrix(K) if offset_range is not None else None
     extra = ()
     if perms is not None:  # the sensitivities' change of each reordering, only the offsets' columns
         a_off = aq[:, :, offsets]
         dA = np.diff(a_off[:, perms.T], axis=1) - np.diff(a_off, axis=1)[:, :, None]  # (B, K-1, S_o, m)
         extra = (dA.reshape(dA.shape[0], K - 1, -1),)
-    Aw, Dw, *dAw = _whiten_batch(v, sm2, np.diff(aq, axis=1), delta, *extra)
-    Q, R = np.linalg.qr(Aw)
+    Q, R, ok, (Dw, *dAw) = _factor(aq, v, sm2, delta, *extra)
     QtD = np.matmul(np.swapaxes(Q, 1, 2), Dw)
     lam = np.sum((Dw - np.matmul(Q, QtD)) ** 2, axis=1)
-    d = np.abs(np.diagonal(R, axis1=1, axis2=2))
-    ok = d.min(axis=1) > 1e-12 * np.maximum(d.max(axis=1), 1e-300)
     lam[~ok] = np.inf
     harm = np.full(lam.shape, np.inf)
-    var = np.full(aq.shape[::2], np.inf)
     order_harm = None if perms is None else np.full((aq.shape[0], len(perms)), np.inf)
+    var, Rinv = _variances(aq, R, ok)
     if np.any(ok):
-        Rinv = np.linalg.inv(R[ok])
-        var[ok] = np.sum(Rinv ** 2, axis=2)  # diag((R^T R)^-1) = diag(F^-1)
         b = np.matmul(Rinv, QtD[ok])[:, offsets]
         sig = np.sqrt(var[ok][:, offsets]) if sigma is None else \
             np.broadcast_to(np.asarray(sigma, float), (len(Rinv), len(offsets)))

@@ -308,23 +308,11 @@ class ReachableRegion(CentredBox):
 
 
 def _feasible(robot, P, margin, jl_rad, signs):
-    """Per-pose feasibility of the reachable set (no clip), bool shape (K,)."""
-    from zerocal_sym.design.terms import _call_ik, _reachable, pose_terms
-    from zerocal_sym.model import kinematics as kin
+    """Per-pose feasibility of the reachable set (no clip), bool shape (K,)
+    (:func:`zerocal_sym.design.feasible.reachable_terms`)."""
+    from zerocal_sym.design.feasible import reachable_terms
 
-    P = np.atleast_2d(P)
-    th, ratio = _call_ik(robot, P)
-    ok = _reachable(ratio, th, 1e-9)
-    if not np.any(ok):
-        return ok
-    t = pose_terms(robot, P[ok])
-    good = np.min(t["s"] * signs, axis=1) >= margin + 1e-9
-    if jl_rad is not None:
-        good &= np.all((t["theta"] >= jl_rad[:, 0] + 1e-9) & (t["theta"] <= jl_rad[:, 1] - 1e-9), axis=1)
-    back = kin.fk(robot, t["theta"])
-    good &= np.linalg.norm(back - P[ok], axis=1) < 1e-6
-    ok[np.flatnonzero(ok)] = good
-    return ok
+    return reachable_terms(robot, P, margin, jl_rad, signs)[0]
 
 
 def mode_signs(robot) -> np.ndarray:

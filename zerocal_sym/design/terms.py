@@ -25,10 +25,9 @@ from zerocal_sym.model import units
 
 def _call_ik(robot, P):
     """Inverse kinematics and reach ratios without checks, shapes (K, m) each."""
-    f = robot.mechanism["ik"]
-    P = np.atleast_2d(np.asarray(P, float))
-    theta, ratio = f(P.T, robot.geometry)
-    return theta.full().T.reshape(len(P), -1), ratio.full().T.reshape(len(P), -1)
+    from zerocal_sym.design.calls import ik
+
+    return ik(robot, P)
 
 
 def _reachable(ratio, theta, tol: float = 0.0) -> np.ndarray:
@@ -194,6 +193,10 @@ def _pose_terms_fn(mech_name: str, params: tuple | None = None):
                        ["P", "g"], ["theta", "ratio", "s", "rho", "a", "dth", "ao"])
 
 
+#: the outputs of :func:`_pose_terms_fn`, in order
+TERM_NAMES = ("theta", "ratio", "s", "rho", "a", "dth", "ao")
+
+
 def pose_terms(robot, P) -> dict:
     """Per-pose quantities of the design model.
 
@@ -210,12 +213,15 @@ def pose_terms(robot, P) -> dict:
         mm; p = m + n, :func:`design_params`), ``dth`` (K, m) d rho / d theta
         (mm/rad), ``ao`` (K, r) d rho / d (omitted errors) (:func:`omitted_params`).
     """
+    from zerocal_sym.design.calls import calls
+
     P = np.atleast_2d(np.asarray(P, float))
-    K = len(P)
-    f = pose_terms_fn(robot)
-    out = f(P.T, robot.geometry)
-    names = ("theta", "ratio", "s", "rho", "a", "dth", "ao")
-    res = {nm: o.full().T.reshape(K, -1) for nm, o in zip(names, out)}
+    return terms_dict(calls(robot)("design_pose_terms", P.T, robot.geometry), len(P))
+
+
+def terms_dict(out, K: int) -> dict:
+    """The design terms of K poses from the outputs of :func:`_pose_terms_fn` over their columns (rows, K)."""
+    res = {nm: o.T.reshape(K, -1) for nm, o in zip(TERM_NAMES, out)}
     res["rho"] = res["rho"][:, 0]
     return res
 

@@ -68,3 +68,63 @@ def mapped(f, K: int, per_pose: tuple) -> FastCall:
             if fc is None:
                 fc = _MAPPED[key] = FastCall(f.map(K, [not m for m in per_pose], [False] * f.n_out(), {}))
     return fc
+
+
+#: chunk sizes of :class:`Columns`: powers of two from SMALLEST_CHUNK to LARGEST_CHUNK columns
+SMALLEST_CHUNK, LARGEST_CHUNK = 8, 1024
+
+
+class Columns:
+    """``f`` (dense column-vector outputs) over any number N of columns of its per-pose inputs, zero-copy.
+
+    A call splits the N columns into chunks of :data:`LARGEST_CHUNK`, then of the power of two that holds the
+    rest if that pads it by at most an eighth (or :data:`SMALLEST_CHUNK` columns), else of the largest power of
+    two within it; padding columns are copies of the chunk's last; each chunk
+    runs through a :class:`FastCall` of ``f`` mapped over that size (the shared inputs not repeated), built once
+    per size.  Every column is evaluated by ``f`` alone, as a call of ``f`` on the N columns would: the
+    numbers are the same whatever the chunks.
+    """
+
+    def __init__(self, f, per_pose: tuple):
+        self.f, self.per_pose = f, tuple(per_pose)
+        self.rows = [f.nnz_out(i) for i in range(f.n_out())]
+        if any(not f.sparsity_out(i).is_dense() or f.size2_out(i) != 1 for i in range(f.n_out())):
+            raise ValueError(f"Columns: {f.name()} has an output that is not a dense column")
+        self._maps = {}
+
+    def _fc(self, B):
+        fc = self._maps.get(B)
+        if fc is None:
+            fc = self._maps[B] = FastCall(self.f.map(B, [not m for m in self.per_pose], [False] * self.f.n_out(),
+                                                     {}))
+        return fc
+
+    def __call__(self, *args):
+        """``args``: the per-pose inputs as arrays (rows, N), the shared ones as vectors; returns the outputs as
+        arrays (rows, N)."""
+        args = [np.asarray(a, float) for a in args]
+        N = next(a.shape[1] for a, pp in zip(args, self.per_pose) if pp)
+        outs = [np.empty((r, N)) for r in self.rows]
+        start = 0
+        while start < N:
+            r = N - start
+            B = max(SMALLEST_CHUNK, 1 << (r - 1).bit_length())  # the power of two that holds the rest
+            if B > LARGEST_CHUNK:
+                B = LARGEST_CHUNK
+            elif B - r > max(SMALLEST_CHUNK, r // 8):  # too much padding: the largest power of two within it
+                B //= 2
+            n = min(B, r)
+            chunk = []
+            for a, pp in zip(args, self.per_pose):
+                if not pp:
+                    chunk.append(a)
+                    continue
+                c = a[:, start:start + n]
+                if n < B:
+                    c = np.concatenate([c, np.repeat(c[:, -1:], B - n, axis=1)], axis=1)
+                chunk.append(c)
+            res = self._fc(B)(*chunk)
+            for o, v, rows in zip(outs, res, self.rows):
+                o[:, start:start + n] = np.reshape(v, (rows, B), order="F")[:, :n]
+            start += n
+        return outs

@@ -1,0 +1,102 @@
+"""A reference set of `zerocal design --optimize` runs and what of each is compared (tests/test_design_reference.py).
+
+``python tests/design_cases.py`` writes ``tests/data/reference_designs.json``: each case's printed report (the
+text, without the time on its ``method:`` line) and its JSON report (``--out``, without the times), as the
+code at that commit computes them, and the versions of the libraries that computed them.  It was written
+before the design's time was cut (one call of the per-pose terms for the feasibility checks and the
+sensitivity, the terms through zero-copy mapped calls, the exchange's objective only on the trials that
+keep the travel and the separation, ...): the test recomputes every case and asks for the same report, bit
+for bit, on the library versions that wrote the file (other builds may change the last bits, and with them
+a point of the certificate's search or a local optimum of Ipopt).
+"""
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import platform
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+REFERENCE = Path(__file__).resolve().parent / "data" / "reference_designs.json"
+
+_REACH = ["--region", "reachable", "--bounds", "-2000", "2000", "450", "2000"]
+_DELTA = ["--robot", str(ROOT / "examples" / "delta.toml")]
+_LINEAR = ["--robot", str(ROOT / "examples" / "linear_delta.toml")]
+
+#: (case id, the arguments of `zerocal design --optimize`)
+CASES = [
+    ("paper-crlb", ["--K", "6", "--criterion", "crlb"]),
+    ("paper-D", ["--K", "6", "--criterion", "D"]),
+    ("paper-checked", ["--K", "6"]),
+    ("paper-reachable-crlb", ["--K", "6", "--criterion", "crlb"] + _REACH),
+    ("paper-reachable-D", ["--K", "6", "--criterion", "D"] + _REACH),
+    ("paper-reachable-checked", ["--K", "6"] + _REACH),
+    ("delta-crlb", _DELTA + ["--K", "12", "--criterion", "crlb"]),
+    ("linear_delta-crlb", _LINEAR + ["--K", "12", "--criterion", "crlb"]),
+]
+
+#: keys whose values measure the machine, not the computation
+TIMING_KEYS = ("time_s", "build_s", "timing_s")
+#: the time on the method line of the text (``; total 5.55 s)``)
+_TOTAL = re.compile(r"; total [0-9.]+ s\)")
+
+
+def run_case(case) -> dict:
+    """``{"text": ..., "report": ...}`` of one case, without the machine's timings."""
+    from zerocal_sym.cli import main
+
+    cid, argv = case
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "design.json"
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            rc = main(["design", "--optimize"] + list(argv) + ["--out", str(out)])
+        if rc not in (0, None):
+            raise RuntimeError(f"{cid}: zerocal design exited with {rc}")
+        report = json.loads(out.read_text())
+    return {"text": _TOTAL.sub("; total - s)", buf.getvalue()), "report": strip(report)}
+
+
+def strip(rep) -> dict:
+    """``rep`` (JSON round trip) without the times."""
+    rep = json.loads(json.dumps(rep, default=float))
+
+    def drop(x):
+        if isinstance(x, dict):
+            return {k: drop(v) for k, v in x.items() if k not in TIMING_KEYS}
+        if isinstance(x, list):
+            return [drop(v) for v in x]
+        return x
+
+    return drop(rep)
+
+
+def versions() -> dict:
+    import casadi
+    import numpy
+    import scipy
+
+    return {"numpy": numpy.__version__, "casadi": casadi.__version__, "scipy": scipy.__version__,
+            "python": platform.python_version(), "machine": platform.machine()}
+
+
+def main():
+    import time
+
+    out = {"versions": versions(), "cases": {}}
+    for case in CASES:
+        t = time.perf_counter()
+        out["cases"][case[0]] = run_case(case)
+        print(f"{case[0]}: {time.perf_counter() - t:.1f} s", flush=True)
+    REFERENCE.parent.mkdir(exist_ok=True)
+    REFERENCE.write_text(json.dumps(out, sort_keys=True, separators=(",", ":")) + "\n")
+    print(f"wrote {REFERENCE}")
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT))
+    main()
