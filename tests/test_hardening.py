@@ -510,7 +510,10 @@ def test_ctrl_c_inside_an_extension_or_an_import(capsys, monkeypatch, exc):
 # =========================================================================== 4. scale (the data side)
 
 def test_duplicate_check_matches_the_pairwise_scan():
-    from zerocal_sym.io.duplicates import _first_duplicate_scan, first_duplicate
+    """Both ways of finding the first repeat (every pair at once for few rows, the hashed cells for many) give
+    the row-by-row scan's answer, and a round has revisits exactly when its pose labels repeat."""
+    from zerocal_sym.io.duplicates import _first_duplicate_scan, first_duplicate, pose_groups
+    from zerocal_sym.model.revisits import PAIRWISE_MAX_K, _first_duplicate_hashed, _first_duplicate_pairwise
 
     rng = np.random.default_rng(7)
     for _ in range(2000):
@@ -519,7 +522,14 @@ def test_duplicate_check_matches_the_pairwise_scan():
         if rng.random() < 0.4:
             a, b = rng.integers(0, K, 2)
             X[a] = X[b] + rng.uniform(-1.2e-3, 1.2e-3, d)
-        assert first_duplicate(X, 1e-3) == _first_duplicate_scan(X, 1e-3)
+        want = _first_duplicate_scan(X, 1e-3)
+        assert first_duplicate(X, 1e-3) == want
+        assert _first_duplicate_pairwise(X, 1e-3) == want
+        assert _first_duplicate_hashed(X, 1e-3) == want
+        assert (want is not None) == (int(pose_groups(X, 1e-3).max()) + 1 < K)
+    X = np.round(rng.random((PAIRWISE_MAX_K + 5, 2)), 1)  # beyond the pairwise size (the hashed cells); 121 cells
+    want = _first_duplicate_scan(X, 1e-3)
+    assert want is not None and first_duplicate(X, 1e-3) == want
 
 
 def big_file(path, K, dup=None):

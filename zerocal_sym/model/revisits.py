@@ -35,14 +35,31 @@ def _first_duplicate_scan(X, tol):
     return None
 
 
+#: up to this many rows :func:`first_duplicate` compares every pair at once (K^2 d numbers: the few poses of a
+#: round in microseconds, where the cells' 3^d neighbour searches would cost more)
+PAIRWISE_MAX_K = 64
+
+
+def _first_duplicate_pairwise(X, tol):
+    """:func:`first_duplicate` by every pair at once (finite ``X``, shape (K, d))."""
+    D = np.max(np.abs(X[:, None, :] - X[None, :, :]), axis=2)
+    rows = np.flatnonzero(np.tril(D <= tol, -1).any(axis=1))
+    if not rows.size:
+        return None
+    k = int(rows[0])
+    return k, int(np.argmin(D[k, :k]))
+
+
 def first_duplicate(X, tol: float):
     """The first row that repeats an earlier one: ``(k, j)`` or None.
 
     ``k`` is the smallest index with an earlier row ``j`` within ``tol`` in
     every column (``max |X_j - X_k| <= tol``), ``j`` the nearest such row (the
-    first of equals).  O(3^d K log K) in time and O(K d) in memory: rows are
-    put in cells of side ``tol`` (hashed); a repeat lies in the same or a
-    neighbouring cell.
+    first of equals).  None at once when the sorted first column has no gap
+    of ``tol`` or less (a repeat is within ``tol`` in that column too); else
+    up to :data:`PAIRWISE_MAX_K` rows every pair at once; beyond, O(3^d K
+    log K) in time and O(K d) in memory: rows are put in cells of side
+    ``tol`` (hashed); a repeat lies in the same or a neighbouring cell.
 
     Parameters
     ----------
@@ -51,8 +68,6 @@ def first_duplicate(X, tol: float):
     tol : float
         > 0.
     """
-    from itertools import product
-
     X = np.asarray(X, float)
     if X.ndim == 1:
         X = X[:, None]
@@ -61,6 +76,19 @@ def first_duplicate(X, tol: float):
         return None
     if not (np.all(np.isfinite(X)) and tol > 0) or float(np.max(np.abs(X))) / tol >= 2.0**50:
         return _first_duplicate_scan(X, tol)
+    if np.all(np.diff(np.sort(X[:, 0])) > tol):  # no two rows within tol in the first column: none repeats
+        return None
+    if K <= PAIRWISE_MAX_K:
+        return _first_duplicate_pairwise(X, tol)
+    return _first_duplicate_hashed(X, tol)
+
+
+def _first_duplicate_hashed(X, tol):
+    """:func:`first_duplicate` through the hashed cells (finite ``X``, shape (K, d), K >= 2; ``tol > 0`` and
+    ``max |X| / tol < 2^50``)."""
+    from itertools import product
+
+    K, d = X.shape
     keys = np.floor(X / tol).astype(np.int64).view(np.uint64)
     if d > len(_HASH):
         return _first_duplicate_scan(X, tol)

@@ -159,11 +159,13 @@ def _edge(f, target, a, b):
 
 
 def has_revisits(robot, theta_cmd) -> bool:
-    """Whether the round visits a pose more than once (O(K log K))."""
-    from zerocal_sym.identify.fisher import pose_labels
+    """Whether the round visits a pose more than once: two rows of the commanded joints (file unit) within
+    :data:`~zerocal_sym.model.revisits.REVISIT_TOL` of each other, as :func:`~zerocal_sym.identify.fisher.pose_labels`
+    groups them (O(K log K))."""
+    from zerocal_sym.model import units
+    from zerocal_sym.model.revisits import REVISIT_TOL, first_duplicate
 
-    lab = pose_labels(robot, theta_cmd)
-    return bool(lab.size) and int(lab.max()) + 1 < lab.size
+    return first_duplicate(units.joints_to_user(robot, np.atleast_2d(theta_cmd)), REVISIT_TOL) is not None
 
 
 def revisit_report(robot, theta_cmd, e, A, noise, err0=None) -> dict | None:
