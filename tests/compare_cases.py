@@ -10,10 +10,10 @@ bit for bit, on the library versions that wrote the file.
 """
 from __future__ import annotations
 
-import json
-import platform
 import sys
 from pathlib import Path
+
+from reference_files import versions, without_times, write_reference  # noqa: F401 (versions: the tests')
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = Path(__file__).resolve().parent / "data" / "reference_compare.json"
@@ -68,39 +68,11 @@ def run_case(case) -> dict:
 
 def strip(rep) -> dict:
     """``rep`` (JSON round trip) without the execution record and the times."""
-    rep = json.loads(json.dumps(rep, default=float))
-    rep.pop("execution", None)
-
-    def drop(x):
-        if isinstance(x, dict):
-            return {k: drop(v) for k, v in x.items() if k not in TIMING_KEYS}
-        if isinstance(x, list):
-            return [drop(v) for v in x]
-        return x
-
-    return drop(rep)
-
-
-def versions() -> dict:
-    import casadi
-    import numpy
-    import scipy
-
-    return {"numpy": numpy.__version__, "casadi": casadi.__version__, "scipy": scipy.__version__,
-            "python": platform.python_version(), "machine": platform.machine()}
+    return without_times(rep, TIMING_KEYS, drop=("execution",))
 
 
 def main():
-    import time
-
-    out = {"versions": versions(), "cases": {}}
-    for case in CASES:
-        t = time.perf_counter()
-        out["cases"][case[0]] = run_case(case)
-        print(f"{case[0]}: {time.perf_counter() - t:.1f} s", flush=True)
-    REFERENCE.parent.mkdir(exist_ok=True)
-    REFERENCE.write_text(json.dumps(out, sort_keys=True, separators=(",", ":")) + "\n")
-    print(f"wrote {REFERENCE}")
+    write_reference(REFERENCE, CASES, run_case)
 
 
 if __name__ == "__main__":

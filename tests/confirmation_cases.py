@@ -15,7 +15,6 @@ from zero needs its blocks).
 """
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -170,18 +169,9 @@ def run_case(case) -> dict:
 
 
 def main():
-    import time
+    from reference_files import write_reference
 
-    from compare_cases import versions
-
-    ref = {"versions": versions(), "cases": {}}
-    for case in CASES:
-        t = time.perf_counter()
-        ref["cases"][case[0]] = run_case(case)
-        print(f"{case[0]}: {time.perf_counter() - t:.2f} s  {ref['cases'][case[0]]['status'][:100]}", flush=True)
-    REFERENCE.parent.mkdir(exist_ok=True)
-    REFERENCE.write_text(json.dumps(ref, sort_keys=True, separators=(",", ":")) + "\n")
-    print(f"wrote {REFERENCE}")
+    write_reference(REFERENCE, CASES, run_case, note=lambda r: r["status"][:100])
 
 
 if __name__ == "__main__":

@@ -192,18 +192,11 @@ def update_tsvd_std():
 
 
 def main():
-    import time
-
     if "--tsvd-std" in sys.argv[1:]:
         return update_tsvd_std()
-    ref = {}
-    for case in CASES:
-        t = time.perf_counter()
-        ref[case[0]] = run_case(case)
-        print(f"{case[0]}: {time.perf_counter() - t:.1f} s", flush=True)
-    REFERENCE.parent.mkdir(exist_ok=True)
-    REFERENCE.write_text(json.dumps(ref, sort_keys=True, separators=(",", ":")) + "\n")
-    print(f"wrote {REFERENCE}")
+    from reference_files import write_reference
+
+    write_reference(REFERENCE, CASES, run_case, with_versions=False)
 
 
 if __name__ == "__main__":
