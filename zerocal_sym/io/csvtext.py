@@ -272,6 +272,22 @@ def _json_line(text: str, key: str):
     return text.count("\n", 0, m.start()) + 1 if m else None
 
 
+def _where(text, key, src):
+    """``src:line`` of ``key``'s first occurrence in the JSON ``text`` (``src`` alone when absent)."""
+    line = _json_line(text, key)
+    return f"{src}:{line}" if line else src
+
+
+def _finite_number(x) -> bool:
+    """A JSON number that is a finite float (not a bool; an integer of 400 digits is not)."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return False
+    try:
+        return math.isfinite(x)
+    except OverflowError:  # an integer beyond any float
+        return False
+
+
 # --------------------------------------------------------------------------- columns from the mechanism
 
 def get_mechanism_of(spec=None):

@@ -16,22 +16,7 @@ import json
 import math
 
 from zerocal_sym.errors import DataFileError
-from zerocal_sym.io.csvtext import _json_line
-
-
-def _finite_number(x) -> bool:
-    """A JSON number that is a finite float (not a bool)."""
-    if isinstance(x, bool) or not isinstance(x, (int, float)):
-        return False
-    try:
-        return math.isfinite(x)
-    except OverflowError:  # an integer beyond any float
-        return False
-
-
-def _where(text, key, src):
-    line = _json_line(text, key)
-    return f"{src}:{line}" if line else src
+from zerocal_sym.io.csvtext import _finite_number, _where
 
 
 #: the values of ``limited_by`` (:data:`zerocal_sym.identify.budget.error_budget.LIMITS`)

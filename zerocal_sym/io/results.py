@@ -38,7 +38,7 @@ import numpy as np
 
 from zerocal_sym.errors import DataFileError
 from zerocal_sym.model.units import DegreeViews
-from zerocal_sym.io.csvtext import (_json_line, _load_json, _read_text, get_mechanism_of, read_as,
+from zerocal_sym.io.csvtext import (_finite_number, _load_json, _read_text, _where, get_mechanism_of, read_as,
                                     unknown_mechanism_message, with_reading_hint)
 from zerocal_sym.io.result_budget import check_error_budget
 
@@ -134,21 +134,6 @@ class ResultFile(DegreeViews):
         if self.mechanism is not None:
             return list(get_mechanism_of(self.mechanism).joint_names)
         return [f"theta{j + 1}" for j in range(self.m)]
-
-
-def _finite_number(x) -> bool:
-    """A JSON number that is a finite float (not a bool; an integer of 400 digits is not)."""
-    if isinstance(x, bool) or not isinstance(x, (int, float)):
-        return False
-    try:
-        return math.isfinite(x)
-    except OverflowError:  # an integer beyond any float
-        return False
-
-
-def _where(text, key, src):
-    line = _json_line(text, key)
-    return f"{src}:{line}" if line else src
 
 
 def _vector(obj, key, names, text, src, required=True, std=False):
