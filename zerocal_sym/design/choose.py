@@ -44,7 +44,7 @@ def choose_design_params(robot, K: int, criterion: str, cons, noise, tolerances,
         no design was found; least first), ``search``, ``model``.
     """
     from zerocal_sym.design.optimize import optimize_design
-    from zerocal_sym.identify.budget.choose import MARGIN, expected_error, held_groups, set_spec
+    from zerocal_sym.identify.budget.choose import expected_error, forward_select, held_groups, set_spec
     from zerocal_sym.model import kinematics as kin
 
     base = robot.identified_set
@@ -71,15 +71,7 @@ def choose_design_params(robot, K: int, criterion: str, cons, noise, tolerances,
                      + (f" ({row['reason']})" if row["reason"] else ""))
         return row
 
-    current, best = (), score(())
-    while True:
-        trial = [score(current + (g,)) for g in gs if g not in current]
-        if not trial:
-            break
-        top = min(trial, key=lambda r: r["expected"])
-        if not top["expected"] < (1 - MARGIN) * best["expected"]:
-            break
-        best, current = top, tuple(top["groups"])
+    best, current = forward_select(score, gs)
     rows.sort(key=lambda r: (r["expected"], len(r["groups"])))
     base_row = next(r for r in rows if not r["groups"])
     return {"chosen": best["params"], "base": base, "freed": list(current), "expected": best["expected"],

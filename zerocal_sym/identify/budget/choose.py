@@ -105,6 +105,23 @@ def expected_error(robot, theta_cmd, params, tolerances: dict, noise=None, err0=
             "identifiable": bool(np.all(np.isfinite(crlb)))}
 
 
+def forward_select(score, groups) -> tuple:
+    """Forward selection: from no group, add the group that lowers ``score(groups)["expected"]`` most, while
+    one lowers it by more than :data:`MARGIN`.  ``score`` takes a tuple of groups and returns a row with
+    ``expected`` and ``groups``; returns ``(the last row kept, its groups)``."""
+    current = ()
+    best = score(current)
+    while True:
+        trial = [score(current + (g,)) for g in groups if g not in current]
+        if not trial:
+            break
+        top = min(trial, key=lambda r: r["expected"])
+        if not top["expected"] < (1 - MARGIN) * best["expected"]:
+            break
+        best, current = top, tuple(top["groups"])
+    return best, current
+
+
 def parsimonious(rows: list) -> dict:
     """Of ``rows`` (``expected``, ``groups``), the one that frees the fewest groups among those within
     :data:`MARGIN` of the least score (then the least score)."""
@@ -145,18 +162,9 @@ def choose_params(robot, theta_cmd, tolerances: dict | None = None, noise=None, 
         search = "exhaustive"
         for combo, _ in candidate_sets(robot, base):
             score(combo)
-    else:  # forward selection: add the group that lowers the score most, while one does
+    else:
         search = "forward"
-        current = ()
-        best = score(current)
-        while True:
-            trial = [score(current + (g,)) for g in gs if g not in current]
-            if not trial:
-                break
-            top = min(trial, key=lambda r: r["expected"])
-            if not top["expected"] < (1 - MARGIN) * best["expected"]:
-                break
-            best, current = top, tuple(top["groups"])
+        forward_select(score, gs)
     rows.sort(key=lambda r: (r["expected"], len(r["groups"])))
     base_row = next(r for r in rows if not r["groups"])
     best = parsimonious(rows)
