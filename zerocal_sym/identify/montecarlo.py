@@ -45,7 +45,7 @@ from zerocal_sym.model import units
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
-from zerocal_sym.identify.loop import calibration_loop, calibration_loops, simulate_round
+from zerocal_sym.identify.loop import calibration_loop, calibration_loops, simulate_rounds
 from zerocal_sym.identify.dask_cluster import describe_scheduler
 from zerocal_sym.identify.parallel import (Progress, Stats, check_execution, chunk_ranges, default_chunk,
                                           run_chunks)
@@ -183,12 +183,12 @@ def _compare_chunk(task: _CompareTask) -> dict:
         r.M.append(report(e[m_:], "maemm"))
         r.comp.append(est4[:m_])
 
-    trials = []  # per trial: its seed, first round and the generator state after it
-    for trial in range(task.start, task.stop):
-        ss = np.random.SeedSequence([task.seed, task.stream, trial])
-        rng1 = np.random.default_rng(ss)
-        meas1 = simulate_round(robot, plant, task.poses, None, noise, rng1, theta=th0)
-        trials.append((ss, meas1, rng1.bit_generator.state))  # every loop: this first round, then its own draws
+    # per trial: its seed, first round and the generator state after it (every loop: this first round, then its
+    # own draws); the first rounds simulated together (as simulate_round each, the same numbers)
+    seeds = [np.random.SeedSequence([task.seed, task.stream, trial]) for trial in range(task.start, task.stop)]
+    rngs = [np.random.default_rng(ss) for ss in seeds]
+    firsts = simulate_rounds(robot, plant, task.poses, [(np.zeros(robot.m), th0, g) for g in rngs], noise)
+    trials = [(ss, m1, g.bit_generator.state) for ss, m1, g in zip(seeds, firsts, rngs)]
     loop_kw = dict(noise=noise, mu0_deg=task.mu0_deg, max_iter=task.max_iter, kappa=False, theta=th0)
     if "tsvd-loop" in methods or "tsvd" in methods:  # the chunk's TSVD loops in lockstep, one batch per round
         runs = calibration_loops(robot, plant, task.poses, identify_tsvd_many,

@@ -94,14 +94,16 @@ def _max_reading(prob, lin, sol, svd, rank, K, names, scale, alpha, checked):
     return max_test(t, np.arange(1, K), delta, alpha, checked)
 
 
-def _lean(robot, names, scale, noise, prior_q, w, sol, K, alpha, prob) -> IdentificationResult:
+def _lean(robot, names, scale, noise, prior_q, w, sol, K, alpha, prob, svd=None, sv=None) -> IdentificationResult:
     """The result ``identify_nlls`` gives for a confirmed point ``sol``: its estimate, covariance and verdict (the
-    fit check's two tests; the per-reading statistics and a rejection's diagnosis left out)."""
+    fit check's two tests; the per-reading statistics and a rejection's diagnosis left out).  ``svd``, ``sv``: the
+    SVDs :func:`information` takes, already computed."""
     errors = robot.errors
     r, rp, J, l, b = sol.r, sol.rp, sol.J, sol.l, sol.b
     has_prior = bool(w.any())
     Jd = J[: K - 1]
-    svd, sv, rank, cov, nonid, offsets_ok = information(J, Jd, r, K, has_prior, noise, scale, names, errors)
+    svd, sv, rank, cov, nonid, offsets_ok = information(J, Jd, r, K, has_prior, noise, scale, names, errors, svd,
+                                                        sv)
     success = sol.converged and offsets_ok and svd is not None
     status = status_line(sol, offsets_ok, rank, names, None, "l2")
     rows = np.flatnonzero(np.any(w != 0, axis=1)) if has_prior else ()
@@ -197,14 +199,35 @@ def identify_rounds(robot, rounds, priors, params, noise, prior_covs=None, alpha
     P = np.array(cols).T
     Z0 = np.array([mus[i] * scale for i in ok]).T
     last = _blocks(prob, Z0, P)
+    done = []  # the confirmed rounds: (i, their last block)
     for j, i in enumerate(ok):
         z, step, r, rp, J, pred, l, b = last[j]
         if not (np.isfinite(z).all() and step < GN_STEP_TOL and ipopt_accepts(J, r, rp, K)):
             single(i)  # Ipopt decides, as in identify_nlls
             continue
+        done.append((i, last[j]))
+    if not done:
+        return out
+    # the SVDs information takes, stacked (each matrix on its own: the same numbers); a J that is not finite is
+    # left to information (none passes ipopt_accepts)
+    fin = [bool(np.isfinite(blk[4]).all()) for _, blk in done]
+    Js = np.array([blk[4] for (_, blk), f in zip(done, fin) if f])
+    svds = np.linalg.svd(Js, full_matrices=False) if len(Js) else None
+    seq = [f and bool(ws[i].any()) and K - 1 > 0 for (i, _), f in zip(done, fin)]
+    svs = np.linalg.svd(Js[np.array(seq)[np.array(fin)]][:, : K - 1], compute_uv=False) if any(seq) else None
+    a = c = 0
+    for (i, (z, step, r, rp, J, pred, l, b)), f, s in zip(done, fin, seq):
+        svd = sv = None
+        if f:
+            svd = (svds[0][a], svds[1][a], svds[2][a])
+            a += 1
+        if s:
+            sv = svs[c]
+            c += 1
         sol = SimpleNamespace(z=z, ret="Solve_Succeeded", converged=True, iterations=0, gn_ok=True, step=step,
                               l=l, b=b, r=r, rp=rp, J=J, pred=pred, confirmation="first-order test")
-        out[i] = _lean(robot, names, scale, noise, np.asarray(priors[i], float), ws[i], sol, K, alpha, prob)
+        out[i] = _lean(robot, names, scale, noise, np.asarray(priors[i], float), ws[i], sol, K, alpha, prob, svd,
+                       sv)
     return out
 
 
