@@ -365,12 +365,13 @@ def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_
         if kappa and not np.isfinite(kap):  # the paper's G (Eq. 28) of this round
             P = kin.fk(robot, meas.theta_cmd + errors.take(prior, offs))
             kap = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
-        out.history.append(IterationRecord(res, user(new), user(inc), mu, kap, maemm.copy()))
+        new_user = user(new)
+        out.history.append(IterationRecord(res, new_user, user(inc), mu, kap, maemm.copy()))
         comp = new
         prior = prior.copy()
         prior[i_off], prior[i_meas] = new, maemm
         if not out.converged:
-            out.compensation_deg, out.maemm_mm, out.iterations = user(new), maemm.copy(), j
+            out.compensation_deg, out.maemm_mm, out.iterations = new_user, maemm.copy(), j
             if mu is not None and mu < mu0_deg:
                 out.converged = True
                 if not run_all:

@@ -42,23 +42,25 @@ def _blocks(prob, z, P):
     of its last block: ``z`` (p,), ``step``, ``r`` (K-1,), ``rp`` (p,), ``J`` (K-1 + p, p), ``pred`` (K-1,), ``l``
     (K-1,), ``b`` (K-2,)."""
     p, n = z.shape
-    last = [None] * n
+    where = [None] * n  # per data set: (its last block's outputs, its column there)
     todo = np.arange(n)
     zc = z.copy()
     for _ in range(GN_BLOCKS):
-        zk, sk, rk, rpk, Jk, pk, lk, bk = prob.run_batch(zc[:, todo], P[:, todo])
-        nxt = []
+        outs = prob.run_batch(zc[:, todo], P[:, todo])
+        zk, sk = outs[0], outs[1]
         for j, i in enumerate(todo.tolist()):
-            zi = np.array(zk[:, j])
-            last[i] = (zi, float(sk[0, j]), np.array(rk[:, j]), np.array(rpk[:, j]),
-                       np.array(Jk[:, j * p:(j + 1) * p], order="F"), np.array(pk[:, j]), np.array(lk[:, j]),
-                       np.array(bk[:, j]))
-            zc[:, i] = zi
-            if np.isfinite(zi).all() and not sk[0, j] < GN_STEP_TOL:
-                nxt.append(i)
-        todo = np.array(nxt, int)
+            where[i] = (outs, j)
+        zc[:, todo] = zk
+        more = np.isfinite(zk).all(axis=0) & ~(sk[0] < GN_STEP_TOL)
+        todo = todo[more]
         if not todo.size:
             break
+    last = []
+    for outs, j in where:
+        zk, sk, rk, rpk, Jk, pk, lk, bk = outs
+        last.append((np.array(zk[:, j]), float(sk[0, j]), np.array(rk[:, j]), np.array(rpk[:, j]),
+                     np.array(Jk[:, j * p:(j + 1) * p], order="F"), np.array(pk[:, j]), np.array(lk[:, j]),
+                     np.array(bk[:, j])))
     return last
 
 
