@@ -26,7 +26,10 @@ round's identifications in one batch
 (:func:`~zerocal_sym.identify.loop.calibration_loops` with
 :func:`~zerocal_sym.identify.tsvd.identify_tsvd_many`, the estimate without
 TSVD's diagnostics: the same numbers as one loop per trial, bit for bit);
-their time per identification is their share of the batch.  The scipy
+their time per identification is their share of the batch.  The Ipopt loops run in lockstep the same way
+(:class:`~zerocal_sym.identify.nlls_rounds.LoopRounds`), and every round of a chunk's loops is simulated in one
+mapped call of the distance (:func:`~zerocal_sym.identify.loop.simulate_rounds`, each loop's own draws in their
+order: the same numbers).  The scipy
 reference evaluates the residuals through zero-copy callbacks
 (:func:`scipy_identify`).  Errors are reported in our frame, or through a
 ``report`` transform (the paper's Table 2 frame:

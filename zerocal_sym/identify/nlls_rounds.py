@@ -10,7 +10,10 @@ estimate, covariance and verdict ``identify_nlls`` would give, from the same fun
 (:func:`~zerocal_sym.identify.estimate.nlls_solve.information`, the fit check's chi² test
 :func:`~zerocal_sym.identify.check.statistics.chi2_test` and its largest standardised residual
 :func:`~zerocal_sym.identify.check.max_reading.max_test`): the same numbers, bit for bit.  Every other round goes
-through :func:`~zerocal_sym.identify.nlls.identify_nlls` itself.
+through :func:`~zerocal_sym.identify.nlls.identify_nlls` itself.  What acts on each round alone is done for all
+of them at once where that gives the same bits: the SVDs stacked (each matrix factored on its own), the compiled
+per-reading terms ``fit_terms`` mapped over the rounds, their largest-residual tests together
+(:func:`~zerocal_sym.identify.check.max_reading.max_tests`).
 
 What a loop reads of a round (``lean`` results): ``success``, ``status``, the estimate and covariance,
 ``info["fit"]["rejected"]`` (and ``max_reading``); the fit check's per-reading statistics and the diagnosis of a
