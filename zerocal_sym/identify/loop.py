@@ -289,8 +289,13 @@ def calibration_loops(robot, plant, poses, identify_many, rngs, noise=None, mu0_
 
     for i in range(n):
         step(i, _steps(robot, plant, poses, noise, rngs[i], mu0_deg, max_iter, maemm_prior, run_all, kappa,
-                       theta, firsts[i]), start=True)
+                       theta, firsts[i], batched=True), start=True)
     while pending:
+        sim = sorted(i for i in pending if pending[i][1] is SIMULATE)
+        if sim:  # the rounds to simulate, in one mapped call
+            for i, meas in zip(sim, simulate_rounds(robot, plant, poses, [pending[i][2] for i in sim], noise)):
+                step(i, pending.pop(i)[0], meas)
+            continue
         live = sorted(pending)
         t0 = time.perf_counter()
         args = (robot, [pending[i][1] for i in live], [pending[i][2] for i in live]) + ((live,) if pass_loops else ())
@@ -303,9 +308,29 @@ def calibration_loops(robot, plant, poses, identify_many, rngs, noise=None, mu0_
     return list(zip(out, calls, secs))
 
 
-def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_all, kappa, theta, first):
+#: what :func:`_steps` (``batched``) yields in place of a round: it is sent the round simulated
+SIMULATE = object()
+
+
+def simulate_rounds(robot, plant, poses, requests, noise) -> list:
+    """The rounds ``simulate_round(robot, plant, poses, comp, noise, rng, theta=theta)`` of several loops, the same
+    numbers, their lengths in one mapped call (:meth:`~zerocal_sym.model.noise.VirtualPlant.measure_many`).
+
+    ``requests``: per loop ``(comp, theta, rng)``, compensation (m,) rad, ``IK(poses)`` (K, m), its Generator.
+    Returns a list of :class:`Measurements`."""
+    poses = np.atleast_2d(np.asarray(poses, float))
+    cmds = [np.asarray(theta, float) - np.asarray(comp, float) for comp, theta, _ in requests]
+    readings = plant.measure_many(cmds, noise, [g for _, _, g in requests])
+    return [Measurements(theta_cmd=c, readings=r, target=poses.copy(), meta={}, source="<simulated>")
+            for c, r in zip(cmds, readings)]
+
+
+def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_all, kappa, theta, first,
+           batched=False):
     """The loop as a generator: yields ``(meas, prior)`` per identification, is sent its result;
-    returns the :class:`LoopResult` (an identification that raised is thrown in)."""
+    returns the :class:`LoopResult` (an identification that raised is thrown in).  ``batched``: yields
+    ``(SIMULATE, (comp, theta, rng))`` for each round after ``first`` and is sent the round
+    (:func:`simulate_rounds`)."""
     rng = np.random.default_rng(rng)
     errors = robot.errors
     offs, meas_names = errors.zero_offsets, errors.measuring
@@ -323,6 +348,8 @@ def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_
     for j in range(1, max_iter + 1):
         if j == 1 and first is not None:
             meas = first
+        elif batched:  # the driver simulates the rounds of all its loops at once (simulate_rounds)
+            meas = yield SIMULATE, (comp, theta, rng)
         else:
             meas = simulate_round(robot, plant, poses, comp, noise, rng, theta=theta)
         res = yield meas, prior.copy()
@@ -338,12 +365,13 @@ def _steps(robot, plant, poses, noise, rng, mu0_deg, max_iter, maemm_prior, run_
         if kappa and not np.isfinite(kap):  # the paper's G (Eq. 28) of this round
             P = kin.fk(robot, meas.theta_cmd + errors.take(prior, offs))
             kap = condition_number(identification_matrix(robot, P, errors.take(prior, meas_names))[0])
-        out.history.append(IterationRecord(res, user(new), user(inc), mu, kap, maemm.copy()))
+        new_user = user(new)
+        out.history.append(IterationRecord(res, new_user, user(inc), mu, kap, maemm.copy()))
         comp = new
         prior = prior.copy()
         prior[i_off], prior[i_meas] = new, maemm
         if not out.converged:
-            out.compensation_deg, out.maemm_mm, out.iterations = user(new), maemm.copy(), j
+            out.compensation_deg, out.maemm_mm, out.iterations = new_user, maemm.copy(), j
             if mu is not None and mu < mu0_deg:
                 out.converged = True
                 if not run_all:

@@ -26,7 +26,10 @@ round's identifications in one batch
 (:func:`~zerocal_sym.identify.loop.calibration_loops` with
 :func:`~zerocal_sym.identify.tsvd.identify_tsvd_many`, the estimate without
 TSVD's diagnostics: the same numbers as one loop per trial, bit for bit);
-their time per identification is their share of the batch.  The scipy
+their time per identification is their share of the batch.  The Ipopt loops run in lockstep the same way
+(:class:`~zerocal_sym.identify.nlls_rounds.LoopRounds`), and every round of a chunk's loops is simulated in one
+mapped call of the distance (:func:`~zerocal_sym.identify.loop.simulate_rounds`, each loop's own draws in their
+order: the same numbers).  The scipy
 reference evaluates the residuals through zero-copy callbacks
 (:func:`scipy_identify`).  Errors are reported in our frame, or through a
 ``report`` transform (the paper's Table 2 frame:
@@ -45,7 +48,7 @@ from zerocal_sym.model import units
 from zerocal_sym.identify import fisher
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.errors import IdentificationError, ZerocalError
-from zerocal_sym.identify.loop import calibration_loop, calibration_loops, simulate_round
+from zerocal_sym.identify.loop import calibration_loop, calibration_loops, simulate_rounds
 from zerocal_sym.identify.dask_cluster import describe_scheduler
 from zerocal_sym.identify.parallel import (Progress, Stats, check_execution, chunk_ranges, default_chunk,
                                           run_chunks)
@@ -183,12 +186,12 @@ def _compare_chunk(task: _CompareTask) -> dict:
         r.M.append(report(e[m_:], "maemm"))
         r.comp.append(est4[:m_])
 
-    trials = []  # per trial: its seed, first round and the generator state after it
-    for trial in range(task.start, task.stop):
-        ss = np.random.SeedSequence([task.seed, task.stream, trial])
-        rng1 = np.random.default_rng(ss)
-        meas1 = simulate_round(robot, plant, task.poses, None, noise, rng1, theta=th0)
-        trials.append((ss, meas1, rng1.bit_generator.state))  # every loop: this first round, then its own draws
+    # per trial: its seed, first round and the generator state after it (every loop: this first round, then its
+    # own draws); the first rounds simulated together (as simulate_round each, the same numbers)
+    seeds = [np.random.SeedSequence([task.seed, task.stream, trial]) for trial in range(task.start, task.stop)]
+    rngs = [np.random.default_rng(ss) for ss in seeds]
+    firsts = simulate_rounds(robot, plant, task.poses, [(np.zeros(robot.m), th0, g) for g in rngs], noise)
+    trials = [(ss, m1, g.bit_generator.state) for ss, m1, g in zip(seeds, firsts, rngs)]
     loop_kw = dict(noise=noise, mu0_deg=task.mu0_deg, max_iter=task.max_iter, kappa=False, theta=th0)
     if "tsvd-loop" in methods or "tsvd" in methods:  # the chunk's TSVD loops in lockstep, one batch per round
         runs = calibration_loops(robot, plant, task.poses, identify_tsvd_many,

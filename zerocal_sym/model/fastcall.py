@@ -44,9 +44,10 @@ class FastCall:
         return st
 
     def __call__(self, *args):
-        buf, trigger, ins, outs = self._state()
+        st = getattr(self._local, "st", None)
+        buf, trigger, ins, outs = self._state() if st is None else st
         for a, v in zip(ins, args):
-            a[:] = np.ravel(v, order="F")
+            a[:] = v.ravel(order="F") if isinstance(v, np.ndarray) else np.ravel(v, order="F")
         trigger()
         return [o.reshape(s, order="F") if s[1] > 1 else o for o, s in zip(outs, self.out_shapes)]
 

@@ -247,7 +247,25 @@ class VirtualPlant:
             without it).
         """
         rng = np.random.default_rng(rng)
-        rho = self.lengths(theta_cmd, noise, rng)
+        return self._readings(self.lengths(theta_cmd, noise, rng), theta_cmd, noise, rng)
+
+    def measure_many(self, theta_cmds, noise: NoiseModel | None, rngs) -> list:
+        """:meth:`measure` of N rounds at once, the same numbers: ``theta_cmds`` (N, K, m) rad, ``rngs`` one
+        numpy Generator per round, each drawn from in :meth:`measure`'s order; the N K lengths in one mapped
+        call of the distance (each column evaluated as alone).  Returns a list of N readings, shape (K,)."""
+        theta = [np.atleast_2d(np.asarray(t, float)) for t in theta_cmds]
+        if noise is not None and noise.sigma_joint > 0:
+            theta = [t + g.normal(0.0, noise.sigma_joint, t.shape) for t, g in zip(theta, rngs)]
+        if not theta:
+            return []
+        K, m = theta[0].shape
+        rho = _distance_columns(self.robot)(np.concatenate(theta).T, self.robot.geometry, self.err)[0]
+        rho = rho.reshape(len(theta), K)
+        return [self._readings(rho[i], t, noise, g) for i, (t, g) in enumerate(zip(theta_cmds, rngs))]
+
+    @staticmethod
+    def _readings(rho, theta_cmd, noise, rng):
+        """The readings (K,) from the lengths ``rho`` (K,): their changes, the scale and shared errors drawn."""
         s = np.diff(rho)
         if noise is not None and noise.sigma_scale_mm > 0:
             s = s + rng.normal(0.0, noise.sigma_scale_mm, s.shape)
@@ -258,6 +276,21 @@ class VirtualPlant:
             u = rng.normal(0.0, noise.sigma_revisit_mm, int(lab.max()) + 1)[lab]
             s = s + np.diff(u)
         return np.concatenate([[0.0], s])
+
+
+_DISTANCE_COLUMNS: dict = {}
+
+
+def _distance_columns(robot):
+    """The mechanism's distance Function over any number of joint columns (:class:`~zerocal_sym.model.fastcall.Columns`,
+    the geometry and the source errors shared), cached per Function."""
+    from zerocal_sym.model.fastcall import Columns
+
+    f = robot.mechanism["distance"]
+    cols = _DISTANCE_COLUMNS.get(id(f))
+    if cols is None or cols[0] is not f:
+        cols = _DISTANCE_COLUMNS[id(f)] = (f, Columns(f, (True, False, False)))
+    return cols[1]
 
 
 def geometry_error(robot, err) -> np.ndarray:

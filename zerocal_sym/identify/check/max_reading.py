@@ -25,7 +25,8 @@ The two tests together reject a clean round at most ``2 alpha`` of the time
 (the union bound); the rate measured: docs/nonlinear.md.
 
 :func:`max_p_value` is the p-value alone; :func:`max_p_values` the same for
-many rounds (:func:`~zerocal_sym.identify.batch.identify_batch`).
+many rounds (:func:`~zerocal_sym.identify.batch.identify_batch`); :func:`max_tests` is :func:`max_test` of many
+rounds.
 """
 from __future__ import annotations
 
@@ -72,3 +73,24 @@ def max_test(t, poses, delta, alpha: float, checked: bool) -> dict | None:
     return {"pose": int(poses[j]), "from_pose": int(poses[j]) - 1, "standardised": float(t[j]),
             "estimated_error_mm": d if math.isfinite(d) else None, "readings": n, "p_value": p,
             "alpha": float(alpha), "rejected": bool(p is not None and p < alpha), "correction": "sidak"}
+
+
+def max_tests(T, poses, D, alpha: float) -> list:
+    """:func:`max_test` (``checked``) of each column of ``T`` and ``D`` (n, N) at the same ``poses`` (n,): the same
+    dicts (the largest ``|t|`` of every column found at once)."""
+    T, D = np.asarray(T, float), np.asarray(D, float)
+    ok = np.isfinite(T)
+    at = np.argmax(np.where(ok, np.abs(T), -1.0), axis=0) if T.size else np.zeros(T.shape[1], int)
+    counts = np.count_nonzero(ok, axis=0)
+    out = []
+    for c, (j, n) in enumerate(zip(at.tolist(), counts.tolist())):
+        if not n:
+            out.append(None)
+            continue
+        t = float(T[j, c])
+        p = max_p_value(abs(t), n)
+        d = float(D[j, c])
+        out.append({"pose": int(poses[j]), "from_pose": int(poses[j]) - 1, "standardised": t,
+                    "estimated_error_mm": d if math.isfinite(d) else None, "readings": n, "p_value": p,
+                    "alpha": float(alpha), "rejected": bool(p < alpha), "correction": "sidak"})
+    return out

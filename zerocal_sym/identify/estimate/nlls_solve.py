@@ -115,7 +115,7 @@ def solve(prob, z0, par, reweight, bounded, lbx, ubx, max_iter, K) -> SimpleName
                            confirmation="ipopt")
 
 
-def information(J, Jd, r, K, has_prior, noise, scale, names, errors):
+def information(J, Jd, r, K, has_prior, noise, scale, names, errors, svd=None, sv=None):
     """Rank, covariance and null space from one SVD of ``J`` (K-1 + p, p): ``F = J^T J = V diag(sJ^2) V^T``.
 
     Returns ``svd`` (J's), ``sv`` (singular values of the data part ``Jd``),
@@ -124,16 +124,18 @@ def information(J, Jd, r, K, has_prior, noise, scale, names, errors):
     every zero offset estimated is identifiable.  A ``J`` that is not finite
     (the exact model cannot be evaluated at the point: a pose is not an
     assembly of the robot with those errors) carries no information: rank 0,
-    no SVD (None), the variances infinite.
+    no SVD (None), the variances infinite.  ``svd`` (J's, ``full_matrices=False``) and ``sv`` (with a prior:
+    ``Jd``'s singular values) when already computed (a batch's stacked SVDs: the same numbers).
     """
     if not np.all(np.isfinite(J)):  # (LAPACK would fail on it, and print to stdout)
         p = J.shape[1]
         cov = np.full((p, p), np.nan)
         np.fill_diagonal(cov, np.inf)
         return None, np.zeros(0), 0, cov, [], not any(n in names for n in errors.zero_offsets)
-    UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False)
+    UJ, sJ, Vt = np.linalg.svd(J, full_matrices=False) if svd is None else svd
     sF = sJ**2
-    sv = (np.linalg.svd(Jd, compute_uv=False) if has_prior else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
+    if sv is None or not has_prior:
+        sv = (np.linalg.svd(Jd, compute_uv=False) if has_prior else sJ[:min(Jd.shape)]) if Jd.size else np.zeros(0)
     tol = RANK_RTOL * (sF[0] if sF.size else 0.0)
     rank = int(np.count_nonzero(sF > tol))
     null = Vt[rank:]
