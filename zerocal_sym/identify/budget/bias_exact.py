@@ -31,8 +31,8 @@ def _anderson(x, f, x_prev, f_prev):
     """The next points of Gauss-Newton iterations ``x -> x + f`` (rows: data sets), each accelerated by
     Anderson mixing of depth one (the secant through the last two steps) where the steps contract, else the
     plain step.  The fixed points are Gauss-Newton's (where ``f = 0``): only the path to them is shorter.  A
-    corner's fit leaves a residual, so Gauss-Newton converges only linearly there (a factor of about 0.3
-    per step on the rotary Delta: 20 steps to 1e-10); the secant makes it superlinear (11).
+    corner's fit leaves a residual, so Gauss-Newton converges only linearly there (on the rotary Delta at
+    K = 10^4 it used every step it was allowed); the secant makes it superlinear.
 
     Shapes: ``x``, ``f``, ``x_prev``, ``f_prev`` (N, p); ``f_prev`` NaN where there is no previous step."""
     g = x + f
