@@ -67,23 +67,31 @@ def _blocks(prob, z, P):
     return last
 
 
+def _validity_and_rank(R, Jd, L, B, S) -> tuple:
+    """What :class:`_Linear` finds of N rounds without prior rows, from their Jacobians' singular values: whether
+    each is valid (its residuals ``R`` (N, K-1), data Jacobian ``Jd`` (N, K-1, p), ``L`` (N, K-1) and ``B``
+    (N, K-2) finite, ``L`` nowhere zero) and its rank (singular values ``S`` (N, p) above ``RANK_RTOL`` times the
+    largest; 0 where not valid: ``_Linear`` zeroes what is not finite and takes its own SVD, and the verdict is
+    "rejected" either way).  Returns ``valid`` (N,) bool and ``rank`` (N,) int."""
+    n = len(R)
+    valid = (np.isfinite(R).all(axis=1) & np.isfinite(Jd).reshape(n, -1).all(axis=1) & np.isfinite(L).all(axis=1)
+             & np.isfinite(B).all(axis=1) & np.all(L != 0, axis=1))
+    rank = np.count_nonzero(S > RANK_RTOL * S[:, :1], axis=1) if S.shape[1] else np.zeros(n, int)
+    return valid, np.where(valid, rank, 0)
+
+
 class _Verdict:
-    """What :func:`~zerocal_sym.identify.check.statistics.chi2_test` reads of a :class:`_Linear` without prior rows,
-    from the SVD ``svd`` of the Jacobian already computed: ``r``, ``valid``, ``dof`` (the same definitions)."""
+    """What :func:`~zerocal_sym.identify.check.statistics.chi2_test` reads of a :class:`_Linear` without prior rows:
+    ``r``, ``valid``, ``dof`` (the same definitions), from :func:`_validity_and_rank` of the round (``known``:
+    ``(valid, rank)`` already computed for many rounds at once; else from the SVD ``svd`` of its Jacobian)."""
 
     def __init__(self, r, Jd, l, b, svd, known=None):
+        if known is None:
+            S = np.atleast_2d(svd[1]) if svd is not None else np.zeros((1, 0))
+            valid, rank = _validity_and_rank(r[None], Jd[None], l[None], b[None], S)
+            known = bool(valid[0]), int(rank[0])
         self.r = r
-        if known is not None:  # (valid, rank) computed for many at once (identify_rounds)
-            self.valid, rank = known
-            self.dof = r.size - (rank if self.valid else 0)
-            return
-        self.valid = bool(np.isfinite(r).all() and np.isfinite(Jd).all() and np.isfinite(l).all()
-                          and np.isfinite(b).all() and np.all(l != 0))
-        if self.valid:
-            s = svd[1]
-            rank = int(np.count_nonzero(s > RANK_RTOL * (s[0] if s.size else 0.0))) if s.size else 0
-        else:  # (_Linear zeroes what is not finite and takes its own SVD; the verdict is "rejected" either way)
-            rank = 0
+        self.valid, rank = known
         self.dof = r.size - rank
 
 
@@ -292,11 +300,8 @@ def identify_rounds(robot, rounds, priors, params, noise, prior_covs=None, alpha
     svds = None
     if len(Js):
         svds = list(np.linalg.svd(Js, full_matrices=False))
-        S = svds[1]
         R, L, B = (np.array([blk[k] for (_, blk), f in zip(done, fin) if f]) for k in (2, 6, 7))
-        valid = (np.isfinite(R).all(axis=1) & np.isfinite(Js[:, : K - 1]).reshape(len(Js), -1).all(axis=1)
-                 & np.isfinite(L).all(axis=1) & np.isfinite(B).all(axis=1) & np.all(L != 0, axis=1))
-        rank = (np.count_nonzero(S > RANK_RTOL * S[:, :1], axis=1) if S.shape[1] else np.zeros(len(Js), int))
+        valid, rank = _validity_and_rank(R, Js[:, : K - 1], L, B, svds[1])
         svds.append(list(zip(valid.tolist(), rank.tolist())))
     seq = [f and bool(ws[i].any()) and K - 1 > 0 for (i, _), f in zip(done, fin)]
     svs = np.linalg.svd(Js[np.array(seq)[np.array(fin)]][:, : K - 1], compute_uv=False) if any(seq) else None
