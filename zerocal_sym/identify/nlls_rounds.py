@@ -36,7 +36,7 @@ from zerocal_sym.identify.estimate.nlls_solve import (GN_STEP_TOL, information, 
                                                      status_line)
 from zerocal_sym.identify.result import IdentificationResult
 from zerocal_sym.identify.whitened import RANK_RTOL, _Linear
-from zerocal_sym.model.fastcall import FastCall
+from zerocal_sym.model.fastcall import mapped
 
 
 def _blocks(prob, z, P):
@@ -161,9 +161,6 @@ def _lean(robot, names, scale, noise, prior_q, st, mr, alpha) -> IdentificationR
                                 std_kind="from residuals" if noise.is_zero else "total")
 
 
-_FIT_TERMS = {}  # (id(fit_terms), N) -> (fit_terms, its FastCall mapped over N columns)
-
-
 def _fit_terms_many(prob, R, J, L, B) -> tuple:
     """``fit_terms`` of n columns at once, each as the single Function evaluates it (one mapped Function per
     :func:`~zerocal_sym.identify.estimate.nlls_problem.batch_size`, the columns padded with copies of the first):
@@ -172,14 +169,10 @@ def _fit_terms_many(prob, R, J, L, B) -> tuple:
     f = prob.functions["fit_terms"]
     n, p = R.shape[1], J.shape[1] // max(1, R.shape[1])
     N = batch_size(n)
-    key = (id(f), N)
-    hit = _FIT_TERMS.get(key)
-    if hit is None or hit[0] is not f:
-        hit = _FIT_TERMS[key] = (f, FastCall(f.map(N)))
     if N > n:
         R, L, B = (np.concatenate([a, np.repeat(a[:, :1], N - n, axis=1)], axis=1) for a in (R, L, B))
         J = np.concatenate([J, np.tile(J[:, :p], (1, N - n))], axis=1)
-    t, _, delta, _ = hit[1](R, J, L, B)
+    t, _, delta, _ = mapped(f, N, (True,) * f.n_in())(R, J, L, B)
     return np.reshape(t, (-1, N), order="F")[:, :n].copy(), np.reshape(delta, (-1, N), order="F")[:, :n].copy()
 
 

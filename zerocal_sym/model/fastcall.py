@@ -59,16 +59,29 @@ _MAPPED: dict = {}
 _MAPPED_LOCK = threading.Lock()
 
 
+def _cached(key, f, make):
+    """The object ``make()`` built for ``f`` under ``key`` (which starts with ``id(f)``), cached; the entry holds
+    ``f`` too, so that its id is not reused by another Function while the entry lives."""
+    hit = _MAPPED.get(key)
+    if hit is None or hit[0] is not f:
+        with _MAPPED_LOCK:
+            hit = _MAPPED.get(key)
+            if hit is None or hit[0] is not f:
+                hit = _MAPPED[key] = (f, make())
+    return hit[1]
+
+
 def mapped(f, K: int, per_pose: tuple) -> FastCall:
     """``f`` mapped over K columns of the inputs flagged in ``per_pose`` (the others shared), cached."""
-    key = (id(f), K, per_pose)
-    fc = _MAPPED.get(key)
-    if fc is None:
-        with _MAPPED_LOCK:
-            fc = _MAPPED.get(key)
-            if fc is None:
-                fc = _MAPPED[key] = FastCall(f.map(K, [not m for m in per_pose], [False] * f.n_out(), {}))
-    return fc
+    per_pose = tuple(per_pose)
+    return _cached((id(f), K, per_pose), f,
+                   lambda: FastCall(f.map(K, [not m for m in per_pose], [False] * f.n_out(), {})))
+
+
+def columns(f, per_pose: tuple) -> "Columns":
+    """:class:`Columns` of ``f`` (the inputs flagged in ``per_pose`` per column, the others shared), cached."""
+    per_pose = tuple(per_pose)
+    return _cached((id(f), "columns", per_pose), f, lambda: Columns(f, per_pose))
 
 
 #: chunk sizes of :class:`Columns`: powers of two from SMALLEST_CHUNK to LARGEST_CHUNK columns

@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from zerocal_sym.model import kinematics as kin
+from zerocal_sym.model.fastcall import columns
 
 #: the names of :meth:`NoiseModel.named` (the CLI's ``--noise`` choices): ``paper`` is the robot's default noise
 #: (the paper's Eqs. 34 and 35 unless the robot file or its mechanism gives its own), ``servo-only`` its joint term
@@ -223,11 +224,15 @@ class VirtualPlant:
         -------
         ndarray, shape (K,)
         """
+        return kin.distance(self.robot, self._servo(theta_cmd, noise, rng), self.err)
+
+    @staticmethod
+    def _servo(theta_cmd, noise, rng):
+        """The joints reached for the commanded ``theta_cmd`` (K, m) rad: the servo error drawn from ``rng``."""
         theta_cmd = np.atleast_2d(np.asarray(theta_cmd, float))
         if noise is not None and noise.sigma_joint > 0:
-            rng = np.random.default_rng(rng)
-            theta_cmd = theta_cmd + rng.normal(0.0, noise.sigma_joint, theta_cmd.shape)
-        return kin.distance(self.robot, theta_cmd, self.err)
+            theta_cmd = theta_cmd + np.random.default_rng(rng).normal(0.0, noise.sigma_joint, theta_cmd.shape)
+        return theta_cmd
 
     def measure(self, theta_cmd, noise: NoiseModel | None = None, rng=None):
         """Scale readings at K commanded poses (head reset after each reading).
@@ -253,13 +258,12 @@ class VirtualPlant:
         """:meth:`measure` of N rounds at once, the same numbers: ``theta_cmds`` (N, K, m) rad, ``rngs`` one
         numpy Generator per round, each drawn from in :meth:`measure`'s order; the N K lengths in one mapped
         call of the distance (each column evaluated as alone).  Returns a list of N readings, shape (K,)."""
-        theta = [np.atleast_2d(np.asarray(t, float)) for t in theta_cmds]
-        if noise is not None and noise.sigma_joint > 0:
-            theta = [t + g.normal(0.0, noise.sigma_joint, t.shape) for t, g in zip(theta, rngs)]
+        theta = [self._servo(t, noise, g) for t, g in zip(theta_cmds, rngs)]
         if not theta:
             return []
-        K, m = theta[0].shape
-        rho = _distance_columns(self.robot)(np.concatenate(theta).T, self.robot.geometry, self.err)[0]
+        K = theta[0].shape[0]
+        distance = columns(self.robot.mechanism["distance"], (True, False, False))
+        rho = distance(np.concatenate(theta).T, self.robot.geometry, self.err)[0]
         rho = rho.reshape(len(theta), K)
         return [self._readings(rho[i], t, noise, g) for i, (t, g) in enumerate(zip(theta_cmds, rngs))]
 
@@ -276,21 +280,6 @@ class VirtualPlant:
             u = rng.normal(0.0, noise.sigma_revisit_mm, int(lab.max()) + 1)[lab]
             s = s + np.diff(u)
         return np.concatenate([[0.0], s])
-
-
-_DISTANCE_COLUMNS: dict = {}
-
-
-def _distance_columns(robot):
-    """The mechanism's distance Function over any number of joint columns (:class:`~zerocal_sym.model.fastcall.Columns`,
-    the geometry and the source errors shared), cached per Function."""
-    from zerocal_sym.model.fastcall import Columns
-
-    f = robot.mechanism["distance"]
-    cols = _DISTANCE_COLUMNS.get(id(f))
-    if cols is None or cols[0] is not f:
-        cols = _DISTANCE_COLUMNS[id(f)] = (f, Columns(f, (True, False, False)))
-    return cols[1]
 
 
 def geometry_error(robot, err) -> np.ndarray:
