@@ -14,11 +14,11 @@ Usage: python benchmarks/design_detection.py [--seeds 5] [--no-entries | --only-
 """
 import argparse
 import math
-from dataclasses import replace
 
 import numpy as np
 
 from zerocal_sym import design
+from zerocal_sym.design.power import lengths_scaled
 from zerocal_sym.identify.nlls import identify_nlls
 from zerocal_sym.model import kinematics as kin
 from zerocal_sym.model.measurements import Measurements
@@ -28,14 +28,9 @@ from zerocal_sym.model.robot import paper_robot
 TRUTH = {"theta1": math.radians(0.156), "theta2": math.radians(-1.859), "rMx": 1.0, "rMy": 0.5}
 
 
-def scaled(robot, f):
-    mm = np.array([robot.mechanism.geometry_units.get(n, "mm") == "mm" for n in robot.mechanism.geometry_names])
-    return replace(robot, geometry=np.where(mm, robot.geometry * f, robot.geometry))
-
-
 def rounds(robot, P, seed):
     plant = VirtualPlant(robot, TRUTH)
-    short = scaled(robot, 0.98)
+    short = lengths_scaled(robot, 0.98)
     th = kin.ik(short, P)
     a = identify_nlls(short, Measurements(theta_cmd=th, readings=plant.measure(th, robot.noise, seed), target=P,
                                           meta={}, source="short"), noise=robot.noise)

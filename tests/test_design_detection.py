@@ -6,7 +6,6 @@ design (the default) has the fit check reject both.
 """
 import json
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -32,16 +31,10 @@ def designs(robot):
             design.optimize_design(robot, 6, "crlb", certificate=False))
 
 
-def _scaled(robot, f):
-    """The robot with every length of its file times f."""
-    mm = np.array([robot.mechanism.geometry_units.get(n, "mm") == "mm" for n in robot.mechanism.geometry_names])
-    return replace(robot, geometry=np.where(mm, robot.geometry * f, robot.geometry))
-
-
 def _rounds(robot, P, seed):
     """Two wrong-data identifications of the design P: a robot file 2 % short, the poses visited in reverse."""
     plant = VirtualPlant(robot, TRUTH)
-    short = _scaled(robot, 0.98)
+    short = pw.lengths_scaled(robot, 0.98)
     th = kin.ik(short, P)  # the controller commands what the wrong file says
     a = identify_nlls(short, Measurements(theta_cmd=th, readings=plant.measure(th, robot.noise, seed), target=P,
                                           meta={}, source="short"), noise=robot.noise)
@@ -78,7 +71,7 @@ def test_noncentrality_is_the_exact_fits_chi2_to_first_order(robot, designs):
     for f in (1e-3, 1e-4):
         d = detection(robot, P, requirement=Requirement(robot, scale_error=f))
         lam = next(s["noncentrality"] for s in d["scenarios"] if s["name"] == "scale")
-        rd = np.concatenate([[0.0], np.diff(kin.distance(_scaled(robot, 1 + f), th))])
+        rd = np.concatenate([[0.0], np.diff(kin.distance(pw.lengths_scaled(robot, 1 + f), th))])
         chi2, dof = _Exact(robot, th, rd, robot.errors.resolve("paper"), robot.errors.zeros(),
                            robot.noise).chi2_fit()
         assert dof == 1

@@ -139,15 +139,21 @@ DEFAULT_SCALE_ERROR = 0.01
 _SCALE_STEP = 1e-6
 
 
-def scale_column(robot, theta) -> np.ndarray:
-    """``d rho / d s`` (mm per unit fraction) of each pose when the robot's lengths are ``(1 + s)`` times the
-    file's (every geometry entry in mm; angles kept), the joints ``theta`` (K, m) commanded, shape (K,)."""
+def lengths_scaled(robot, f: float):
+    """The robot with every length of its file (every geometry entry in mm) times ``f``, its angles kept: the
+    file of another robot of the family, or one in other units."""
     from dataclasses import replace
 
+    mm = np.array([robot.mechanism.geometry_units.get(n, "mm") == "mm" for n in robot.mechanism.geometry_names])
+    return replace(robot, geometry=np.where(mm, robot.geometry * f, robot.geometry))
+
+
+def scale_column(robot, theta) -> np.ndarray:
+    """``d rho / d s`` (mm per unit fraction) of each pose when the robot's lengths are ``(1 + s)`` times the
+    file's (:func:`lengths_scaled`), the joints ``theta`` (K, m) commanded, shape (K,)."""
     from zerocal_sym.model import kinematics as kin
 
-    mm = np.array([robot.mechanism.geometry_units.get(n, "mm") == "mm" for n in robot.mechanism.geometry_names])
-    scaled = replace(robot, geometry=np.where(mm, robot.geometry * (1.0 + _SCALE_STEP), robot.geometry))
+    scaled = lengths_scaled(robot, 1.0 + _SCALE_STEP)
     theta = np.atleast_2d(theta)
     return (kin.distance(scaled, theta) - kin.distance(robot, theta)) / _SCALE_STEP
 
