@@ -35,7 +35,7 @@ import numpy as np
 
 from zerocal_sym.identify import banded
 from zerocal_sym.identify.estimate import nlls_problem
-from zerocal_sym.identify.estimate.nlls_problem import GN_BLOCKS, IPOPT_OPTIONS, N_GN, get_problem
+from zerocal_sym.identify.estimate.nlls_problem import GN_BLOCKS, N_GN, get_problem, ipopt_solver
 
 _CACHE: dict = {}
 _LOCK = threading.Lock()
@@ -175,21 +175,11 @@ class BandedProblem:
 
     def solver_for(self, max_iter):
         """Ipopt on ``0.5 c |r(z; l, b)|^2`` (the NLP parameters ``[par, l, b, c]``) with the Gauss-Newton
-        Hessian, the options of the CasADi problem's (:data:`IPOPT_OPTIONS`), its functions numpy callbacks.
+        Hessian (:func:`~zerocal_sym.identify.estimate.nlls_problem.ipopt_solver`), its functions numpy callbacks.
         Returns a :class:`~zerocal_sym.model.fastcall.FastCall`: ``solver(x0, p, lbx, ubx)``, ``.stats()``."""
-        import casadi as ca
-
-        from zerocal_sym.model.fastcall import FastCall
-
         if max_iter not in self._solvers:
             cbs = _callbacks(self)
-            x, pp = ca.MX.sym("x", self.p), ca.MX.sym("p", self.npar_nlp)
-            oracle = ca.Function("nlls_nlp", [x, pp], [cbs["f"](x, pp), ca.MX(0, 1)], ["x", "p"], ["f", "g"])
-            opts = dict(IPOPT_OPTIONS, grad_f=cbs["grad_f"], hess_lag=cbs["hess"], calc_lam_p=False,
-                        calc_lam_x=False, bound_consistency=False)
-            if max_iter is not None:
-                opts["ipopt.max_iter"] = int(max_iter)
-            solver = FastCall(ca.nlpsol("nlls", "ipopt", oracle, opts))
+            solver = ipopt_solver(self.p, self.npar_nlp, cbs["f"], cbs["grad_f"], cbs["hess"], max_iter)
             solver._callbacks = cbs  # alive as long as the solver
             self._solvers[max_iter] = solver
         return self._solvers[max_iter]

@@ -62,6 +62,22 @@ IPOPT_OPTIONS = {
     "show_eval_warnings": False,
 }
 
+
+def ipopt_solver(p: int, npar: int, f, grad_f, hess_lag, max_iter=None) -> FastCall:
+    """Ipopt (:data:`IPOPT_OPTIONS`; ``max_iter``: its iteration limit, None the default) on the unconstrained NLP
+    ``min_x f(x, p)`` (``x`` of size p, parameters of size npar), its gradient ``grad_f`` and Lagrangian Hessian
+    ``hess_lag`` given as Functions (or callbacks); as a :class:`FastCall`: ``solver(x0, p, lbx, ubx)``."""
+    import casadi as ca
+
+    x, pp = ca.MX.sym("x", p), ca.MX.sym("p", npar)
+    oracle = ca.Function("nlls_nlp", [x, pp], [f(x, pp), ca.MX(0, 1)], ["x", "p"], ["f", "g"])
+    opts = dict(IPOPT_OPTIONS, grad_f=grad_f, hess_lag=hess_lag, calc_lam_p=False, calc_lam_x=False,
+                bound_consistency=False)
+    if max_iter is not None:
+        opts["ipopt.max_iter"] = int(max_iter)
+    return FastCall(ca.nlpsol("nlls", "ipopt", oracle, opts))
+
+
 #: up to this K the functions are SX, expanded (fastest to evaluate); above, MX graphs with the per-pose
 #: model mapped over K (build time and memory linear in K, no K-fold inlining)
 EXPAND_MAX_K = 120
@@ -320,19 +336,12 @@ class NllsProblem:
         ``solver.stats()`` the Ipopt statistics of the last call.  The NLP is
         the objective Function wrapped (its gradient and Gauss-Newton Hessian
         given as ``grad_f`` and ``hess_lag``), so the compiled twins serve
-        Ipopt too.
+        Ipopt too (:func:`ipopt_solver`).
         """
-        import casadi as ca
-
         fs = self._sync()
         if max_iter not in self._solvers:
-            x, pp = ca.MX.sym("x", self.p), ca.MX.sym("p", self.npar_nlp)
-            oracle = ca.Function("nlls_nlp", [x, pp], [fs["nlp_f"](x, pp), ca.MX(0, 1)], ["x", "p"], ["f", "g"])
-            opts = dict(IPOPT_OPTIONS, grad_f=fs["nlp_grad_f"], hess_lag=fs["nlp_hess_l"], calc_lam_p=False,
-                        calc_lam_x=False, bound_consistency=False)
-            if max_iter is not None:
-                opts["ipopt.max_iter"] = int(max_iter)
-            self._solvers[max_iter] = FastCall(ca.nlpsol("nlls", "ipopt", oracle, opts))
+            self._solvers[max_iter] = ipopt_solver(self.p, self.npar_nlp, fs["nlp_f"], fs["nlp_grad_f"],
+                                                   fs["nlp_hess_l"], max_iter)
         return self._solvers[max_iter]
 
     @property
